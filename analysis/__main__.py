@@ -1,0 +1,54 @@
+"""Analyze and report stages CLI.
+
+    python -m analysis                                   every experiment with runs on disk, then the report
+    python -m analysis experiment=<slug>/<name>          one experiment's metrics and figures, then the report
+    python -m analysis stage=report                      only the report, from the metrics on disk
+    python -m analysis data_dir=/elsewhere ...           where runs are read and outputs written (default data)
+"""
+
+from __future__ import annotations
+
+import difflib
+import sys
+from pathlib import Path
+
+KEYS = {"experiment": None, "data_dir": "data", "stage": "all"}
+STAGES = ("all", "analyze", "report")
+
+
+def parse(argv: list[str]) -> dict[str, str | None]:
+    from pipeline.core.experiment import available_experiments
+
+    args = dict(KEYS)
+    for arg in argv:
+        key, eq, value = arg.partition("=")
+        if not eq:
+            raise ValueError(f"expected key=value, got '{arg}' (keys: {', '.join(KEYS)})")
+        if key not in KEYS:
+            hint = difflib.get_close_matches(key, KEYS, n=1)
+            raise ValueError(f"unknown key '{key}'" + (f" (did you mean '{hint[0]}'?)" if hint else
+                                                       f"; keys: {', '.join(KEYS)}"))
+        args[key] = value
+    if args["stage"] not in STAGES:
+        raise ValueError(f"stage={args['stage']} must be one of {', '.join(STAGES)}")
+    known = available_experiments()
+    if args["experiment"] is not None and args["experiment"] not in known:
+        hint = difflib.get_close_matches(args["experiment"], known, n=1)
+        raise ValueError(f"unknown experiment '{args['experiment']}'"
+                         + (f" (did you mean '{hint[0]}'?)" if hint else f"; one of {', '.join(known)}"))
+    return args
+
+
+def main() -> None:
+    try:
+        args = parse(sys.argv[1:])
+    except ValueError as err:
+        print(f"error: {err}", file=sys.stderr)
+        sys.exit(2)
+    from analysis.core.stages import run
+
+    sys.exit(run(Path(args["data_dir"]), args["experiment"], args["stage"]))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,336 @@
+"""One run = one MCAP file: writing it safely and reading it back as pandas DataFrames.
+
+Log time is simulated time in nanoseconds from 0, so two runs of the same config are byte-comparable
+message by message. A run is written to a hidden `.partial` name and renamed only when complete: a killed
+run never leaves a file that looks finished, and a re-run replaces the old file atomically.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import os
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import foxglove
+import numpy as np
+import pandas as pd
+import yaml
+from foxglove.mcap import MCAPWriteOptions
+from google.protobuf import descriptor_pb2
+from google.protobuf.descriptor import Descriptor, FieldDescriptor
+from google.protobuf.message import Message
+from mcap.reader import make_reader
+from mcap_protobuf.decoder import DecoderFactory
+
+from pipeline.core import schemas
+from pipeline.core.encoding import encode_series
+from pipeline.robotics.transforms import quaternion_wxyz
+
+RUN_SUFFIX = ".mcap"
+PARTIAL_SUFFIX = ".mcap.partial"
+METADATA_NAME = "run"
+CONFIG_ATTACHMENT = "config.yaml"
+CHUNK_BYTES = 1024 * 1024
+
+
+class SimulationFailed(RuntimeError):
+    """A run that cannot go on (divergence, NaN, solver breakdown); recorded as `failed: <reason>`."""
+
+
+def seconds_to_ns(t: float | np.ndarray) -> int | np.ndarray:
+    if isinstance(t, np.ndarray):
+        return np.rint(t * 1e9).astype(np.int64)
+    return round(t * 1e9)
+
+
+def _file_descriptor_set(descriptor: Descriptor) -> bytes:
+    """The schema bytes MCAP wants for protobuf: the message's file and all it imports."""
+    fds = descriptor_pb2.FileDescriptorSet()
+    seen: set[str] = set()
+
+    def add(file) -> None:
+        if file.name in seen:
+            return
+        seen.add(file.name)
+        for dep in file.dependencies:
+            add(dep)
+        file.CopyToProto(fds.file.add())
+
+    add(descriptor.file)
+    return fds.SerializeToString()
+
+
+class RunWriter:
+    """Writes one run. Use as a context manager; `close(status)` publishes the file.
+
+    Messages wait in memory per topic and are written topic by topic at close (the MCAP writer is the
+    Foxglove SDK's, in Rust), each topic ending its chunk: a reader that wants one topic then
+    decompresses only that topic's chunks. Series of doubles are encoded in one NumPy pass."""
+
+    def __init__(self, path: Path, metadata: Mapping[str, Any]):
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._partial = self.path.with_name(f".{self.path.stem}{PARTIAL_SUFFIX}")
+        self._context = foxglove.Context()
+        self._writer = foxglove.open_mcap(
+            self._partial, allow_overwrite=True, context=self._context,
+            writer_options=MCAPWriteOptions(chunk_size=CHUNK_BYTES, compression_threads=0))
+        self._open = True
+        self._types: dict[str, type[Message]] = {}
+        self._pending: dict[str, list[tuple[np.ndarray, list[bytes]]]] = {}
+        self.metadata = {k: v if isinstance(v, str) else json.dumps(v) for k, v in metadata.items()}
+
+    # -- messages ---------------------------------------------------------------------------------
+    @staticmethod
+    def _schema(topic: str) -> type[Message]:
+        cls = schemas.for_topic(topic)
+        if cls is None:
+            raise KeyError(f"{topic} is not a common topic: pass its message_type")
+        return cls
+
+    def _queue(self, topic: str, message_type: type[Message]) -> list[tuple[np.ndarray, list[bytes]]]:
+        known = self._types.get(topic)
+        if known is None:
+            expected = schemas.for_topic(topic)
+            if expected is not None and expected is not message_type:
+                raise TypeError(f"topic {topic} is reserved for {expected.DESCRIPTOR.full_name}")
+            self._types[topic] = message_type
+            self._pending[topic] = []
+        elif known is not message_type:
+            raise TypeError(f"topic {topic} carries {known.DESCRIPTOR.full_name}, not "
+                            f"{message_type.DESCRIPTOR.full_name}")
+        return self._pending[topic]
+
+    def write(self, topic: str, t_ns: int, message: Message) -> None:
+        """Queue a ready-made message at simulated time `t_ns`."""
+        self._queue(topic, type(message)).append((np.array([t_ns], dtype=np.int64), [message.SerializeToString()]))
+
+    def log(self, topic: str, t: float, message_type: type[Message] | None = None, **fields: Any) -> None:
+        """Write one record at simulated time `t` (s); common topics know their schema."""
+        cls = message_type or self._schema(topic)
+        self.write(topic, seconds_to_ns(t), cls(**fields))
+
+    def log_series(self, topic: str, times: np.ndarray, message_type: type[Message] | None = None,
+                   **columns: Any) -> None:
+        """Write one record per sample: a NumPy array column gives sample i its row i (a 1-D array
+        fills a scalar field, a 2-D array a repeated one); anything else (names as a list, a string) is
+        the same in every record."""
+        cls = message_type or self._schema(topic)
+        times_ns = seconds_to_ns(np.asarray(times, dtype=float))
+        per_sample = {k: v for k, v in columns.items() if isinstance(v, np.ndarray)}
+        constant = {k: v for k, v in columns.items() if k not in per_sample}
+        for k, v in per_sample.items():
+            if len(v) != len(times_ns):
+                raise ValueError(f"{topic}: column {k} has {len(v)} samples for {len(times_ns)} times")
+        encoded = encode_series(cls, constant, per_sample)
+        if encoded is None:
+            rows = {k: v.tolist() for k, v in per_sample.items()}
+            encoded = [cls(**constant, **{k: v[i] for k, v in rows.items()}).SerializeToString()
+                       for i in range(len(times_ns))]
+        self._queue(topic, cls).append((times_ns, encoded))
+
+    def log_transforms(self, times: np.ndarray, parent: str, children: Sequence[str],
+                       matrices: np.ndarray, topic: str = "/tf") -> None:
+        """Foxglove FrameTransforms: `matrices` (N, k, 4, 4) are the poses of the k `children` in
+        `parent` at each of the N `times` (s). Foxglove's 3D panel and Rerun draw them as a frame tree."""
+        matrices = np.asarray(matrices, dtype=float)
+        quats = quaternion_wxyz(matrices[..., :3, :3]).tolist()
+        trans = matrices[..., :3, 3].tolist()
+        times_ns = seconds_to_ns(np.asarray(times, dtype=float))
+        # one message, updated in place per sample: building k nested messages anew costs 4x more
+        msg = schemas.FrameTransforms(transforms=[schemas.FrameTransform(parent_frame_id=parent, child_frame_id=c)
+                                                  for c in children])
+        items = list(msg.transforms)
+        encoded = []
+        for t_ns, positions, rotations in zip(times_ns.tolist(), trans, quats, strict=True):
+            seconds, nanos = divmod(t_ns, 1_000_000_000)
+            for item, p, q in zip(items, positions, rotations, strict=True):
+                item.timestamp.seconds, item.timestamp.nanos = seconds, nanos
+                tr, rot = item.translation, item.rotation
+                tr.x, tr.y, tr.z = p
+                rot.w, rot.x, rot.y, rot.z = q
+            encoded.append(msg.SerializeToString())
+        self._queue(topic, schemas.FrameTransforms).append((times_ns, encoded))
+
+    def attach(self, name: str, data: bytes | str, media_type: str) -> None:
+        self._writer.attach(log_time=0, create_time=0, name=name, media_type=media_type,
+                            data=data.encode() if isinstance(data, str) else data)
+
+    # -- lifecycle --------------------------------------------------------------------------------
+    def _flush_topics(self) -> None:
+        for topic, parts in self._pending.items():
+            cls = self._types[topic]
+            channel = foxglove.Channel(topic, schema=foxglove.Schema(
+                name=cls.DESCRIPTOR.full_name, encoding="protobuf", data=_file_descriptor_set(cls.DESCRIPTOR)),
+                message_encoding="protobuf", context=self._context)
+            times = np.concatenate([t for t, _ in parts])
+            data = [b for _, chunk in parts for b in chunk]
+            if len(times) > 1 and (np.diff(times) < 0).any():
+                order = np.argsort(times, kind="stable")  # equal times keep their logging order
+                times, data = times[order], [data[i] for i in order.tolist()]
+            log = channel.base.log  # the Rust channel itself: the Python wrapper only re-checks types
+            for t_ns, payload in zip(times.tolist(), data, strict=True):
+                log(payload, log_time=t_ns)
+            self._writer.flush()  # end the chunk: the next topic starts its own
+        self._pending.clear()
+
+    def close(self, status: str) -> Path:
+        """Record the status, finish the file and publish it under its final name."""
+        self._flush_topics()
+        self._writer.write_metadata(METADATA_NAME, {**self.metadata, "status": status})
+        self._writer.close()
+        self._open = False
+        with open(self._partial, "rb+") as f:
+            os.fsync(f.fileno())
+        os.replace(self._partial, self.path)
+        return self.path
+
+    def abort(self) -> None:
+        """Drop the unfinished file (interrupt): the previous complete run, if any, is untouched."""
+        if self._open:
+            self._writer.close()
+            self._open = False
+        self._partial.unlink(missing_ok=True)
+
+    def __enter__(self) -> RunWriter:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if self._open:
+            self.abort()
+
+
+# ---------------------------------------------------------------------------------------------------
+# Reading
+
+
+class Run:
+    """A run read back: metadata, resolved config, attachments, and one DataFrame per topic (indexed by
+    simulated time `t` in s), decoded the first time it is asked for."""
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        with open(self.path, "rb") as f:
+            reader = make_reader(f)
+            self.metadata: dict[str, str] = {}
+            for record in reader.iter_metadata():
+                if record.name == METADATA_NAME:
+                    self.metadata = dict(record.metadata)
+            self.attachments: dict[str, bytes] = {a.name: a.data for a in reader.iter_attachments()}
+            summary = reader.get_summary()
+        if not self.metadata:
+            raise ValueError(f"{self.path} has no '{METADATA_NAME}' metadata record: not a complete run file")
+        self.topic_names = sorted({c.topic for c in summary.channels.values()}) if summary else []
+        self._frames: dict[str, pd.DataFrame] = {}
+
+    def __repr__(self) -> str:
+        return f"Run({self.path.name}, status={self.status!r}, topics={self.topic_names})"
+
+    @property
+    def run_id(self) -> str:
+        return self.metadata["run_id"]
+
+    @property
+    def status(self) -> str:
+        return self.metadata["status"]
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    @property
+    def config(self) -> dict[str, Any]:
+        return yaml.safe_load(self.attachments[CONFIG_ATTACHMENT])
+
+    @property
+    def params(self) -> dict[str, Any]:
+        """The command-line overrides that distinguish this run in a sweep."""
+        return json.loads(self.metadata.get("params", "{}"))
+
+    @property
+    def topics(self) -> dict[str, pd.DataFrame]:
+        """Every topic as a DataFrame (decodes all of them)."""
+        return {topic: self[topic] for topic in self.topic_names}
+
+    def __getitem__(self, topic: str) -> pd.DataFrame:
+        if topic not in self._frames:
+            if topic not in self.topic_names:
+                raise KeyError(f"{self.path.name} has no topic {topic}; it has {self.topic_names}")
+            self._frames.update(_decode(self.path, [topic]))
+        return self._frames[topic]
+
+
+def _is_repeated(fd: FieldDescriptor) -> bool:
+    return fd.is_repeated if hasattr(fd, "is_repeated") else fd.label == FieldDescriptor.LABEL_REPEATED
+
+
+@functools.cache
+def _plan(descriptor: Descriptor) -> tuple[bool, tuple[tuple[str, bool, bool], ...]]:
+    """(labels entries by `name`, [(field, repeated, is_message)]) without the timestamp."""
+    name = descriptor.fields_by_name.get("name")
+    labelled = name is not None and _is_repeated(name)
+    fields = tuple((fd.name, _is_repeated(fd), fd.message_type is not None) for fd in descriptor.fields
+                   if not (fd.message_type is not None and fd.message_type.full_name == "google.protobuf.Timestamp")
+                   and not (labelled and fd.name == "name"))
+    return labelled, fields
+
+
+def _flatten(message: Message, prefix: str, row: dict[str, Any]) -> None:
+    """Message -> flat columns. Repeated scalars are labelled by the message's `name` list if it has
+    one of the same length (`position.shoulder`), else by index (`position[0]`); repeated messages by
+    their `child_frame_id`/`name` if they carry one."""
+    labelled, fields = _plan(message.DESCRIPTOR)
+    names = list(message.name) if labelled else None
+    for field_name, repeated, is_message in fields:
+        value = getattr(message, field_name)
+        key = prefix + field_name
+        if repeated and is_message:
+            for i, item in enumerate(value):
+                label = getattr(item, "child_frame_id", "") or getattr(item, "name", "") or str(i)
+                _flatten(item, f"{key}.{label}.", row)
+        elif repeated:
+            if names is not None and len(names) == len(value):
+                row.update(zip([f"{key}.{n}" for n in names], value, strict=True))
+            else:
+                row.update((f"{key}[{i}]", v) for i, v in enumerate(value))
+        elif is_message:
+            _flatten(value, key + ".", row)
+        else:
+            row[key] = value
+
+
+def _decode(path: Path, topics: Iterable[str]) -> dict[str, pd.DataFrame]:
+    rows: dict[str, list[dict[str, Any]]] = {}
+    times: dict[str, list[int]] = {}
+    with open(path, "rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        # file order, not a global log-time merge (costly); each topic is sorted on its own below
+        for _schema, channel, message, decoded in reader.iter_decoded_messages(topics=list(topics),
+                                                                                log_time_order=False):
+            row: dict[str, Any] = {}
+            _flatten(decoded, "", row)
+            rows.setdefault(channel.topic, []).append(row)
+            times.setdefault(channel.topic, []).append(message.log_time)
+    frames = {}
+    for topic, topic_rows in rows.items():
+        index = pd.Index(np.asarray(times[topic], dtype=np.int64) / 1e9, name="t")
+        frames[topic] = pd.DataFrame.from_records(topic_rows, index=index).sort_index(kind="stable")
+    return frames
+
+
+def read_run(path: str | Path) -> Run:
+    """Open one run file: metadata and attachments now, topics as they are used."""
+    return Run(path)
+
+
+def run_files(directory: str | Path) -> list[Path]:
+    """Complete run files in a directory, sorted; unfinished `.partial` files are never listed."""
+    directory = Path(directory)
+    return sorted(p for p in directory.glob(f"*{RUN_SUFFIX}") if not p.name.startswith("."))
+
+
+def read_runs(directory: str | Path) -> list[Run]:
+    return [read_run(p) for p in run_files(directory)]

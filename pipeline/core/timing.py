@@ -1,0 +1,61 @@
+"""Compute time, measured the same way for every algorithm a paper times.
+
+Warm-up calls first (caches, lazy imports, branch predictors), garbage collection off while timing,
+one `perf_counter_ns` pair around each call, every sample kept: the report shows median and p95, and
+the samples go to the `/compute_time` channel. Runs single-threaded (the pipeline runs one process per
+core); the machine goes into the run metadata.
+"""
+
+from __future__ import annotations
+
+import gc
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Timing:
+    name: str
+    seconds: np.ndarray          # one entry per timed call
+    items_per_call: int = 1      # poses per call for batched forms: per-item time = seconds / items
+
+    @property
+    def median(self) -> float:
+        return float(np.median(self.seconds))
+
+    @property
+    def p95(self) -> float:
+        return float(np.percentile(self.seconds, 95))
+
+    def summary_us(self) -> dict[str, float]:
+        per_item = self.seconds / self.items_per_call * 1e6
+        return {"median_us": float(np.median(per_item)), "p95_us": float(np.percentile(per_item, 95))}
+
+
+def time_calls(name: str, fn: Callable[..., Any], inputs: Sequence[tuple], *, warmup: int = 100,
+               repeats: int = 1, items_per_call: int = 1) -> Timing:
+    """Time `fn(*args)` for each args tuple in `inputs`, `repeats` passes, after `warmup` calls."""
+    if not inputs:
+        raise ValueError("time_calls needs at least one input")
+    for k in range(warmup):
+        fn(*inputs[k % len(inputs)])
+    clock = time.perf_counter_ns
+    samples = np.empty(len(inputs) * repeats)
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        k = 0
+        for _ in range(repeats):
+            for args in inputs:
+                start = clock()
+                fn(*args)
+                samples[k] = clock() - start
+                k += 1
+    finally:
+        if enabled:
+            gc.enable()
+    return Timing(name, samples * 1e-9, items_per_call)

@@ -1,0 +1,73 @@
+"""`ur5-ik-fsm`: Villalobos, Sanchez, Martell — Singularity Analysis and Complete Methods to Compute the
+Inverse Kinematics for a 6-DOF UR/TM-Type Robot (Robotics 2022, 11, 137).
+
+The importable API (SI units, the paper's Table 1 DH):
+
+    fk(q) -> (4, 4)                              forward kinematics, eqs. (1)-(13)
+    ik_all(T) -> (k, 6)                          every valid solution, paper branch order
+    ik_min_displacement(T, q_prev) -> (6,)|None  Algorithm 1
+    ik_fsm(T, q_prev) -> (6,)|None               Algorithm 2 (finite-state machine)
+    ik_batch(T (N,4,4), q_prev, algorithm) -> (N, 6), NaN rows where no valid set
+    jacobian(q) -> (6, 6), det_j(q)              eqs. (33)-(46)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, Range
+from pipeline.papers.ur5_ik_fsm import ik
+from pipeline.papers.ur5_ik_fsm.ik import PAPER, Conventions
+from pipeline.papers.ur5_ik_fsm.kinematics import UR5, Geometry, det_j, fk, jacobian, shoulder_term
+
+__all__ = ["PAPER", "UR5", "Conventions", "Geometry", "det_j", "fk", "ik_all", "ik_batch", "ik_fsm",
+           "ik_min_displacement", "jacobian", "shoulder_term"]
+
+
+def ik_all(T, g: Geometry = UR5, c: Conventions = PAPER) -> np.ndarray:
+    """Every valid joint set for pose T, in the paper's branch order; shape (k, 6), k ≤ 8."""
+    return np.array([q for _, q, ok in ik.branches(np.asarray(T, dtype=float), g, c) if ok]).reshape(-1, 6)
+
+
+def ik_min_displacement(T, q_prev, g: Geometry = UR5, c: Conventions = PAPER) -> np.ndarray | None:
+    """Algorithm 1: the valid set closest to q_prev (Euclidean, eq. 48); None if there is none."""
+    q = ik.min_displacement(np.asarray(T, dtype=float), q_prev, g, c).q
+    return None if q is None else np.array(q)
+
+
+def ik_fsm(T, q_prev, g: Geometry = UR5, c: Conventions = PAPER) -> np.ndarray | None:
+    """Algorithm 2: the finite-state machine's set; None if there is none."""
+    q = ik.fsm(np.asarray(T, dtype=float), q_prev, g, c).q
+    return None if q is None else np.array(q)
+
+
+def ik_batch(T, q_prev, algorithm: str = "alg2", g: Geometry = UR5, c: Conventions = PAPER) -> np.ndarray:
+    """Many poses in one call: T (N, 4, 4), q_prev (6,) or (N, 6) -> (N, 6), NaN rows where none."""
+    return ik.solve_batch(T, q_prev, algorithm, g, c)[0]
+
+
+def __getattr__(name: str):
+    # The experiments pull in MuJoCo and Hydra; the kinematics API above does not need them.
+    if name == "EXPERIMENTS":
+        from pipeline.papers.ur5_ik_fsm import experiments
+
+        return {"tables": experiments.tables, "singular-paths": experiments.singular_paths,
+                "compute-time": experiments.compute_time}
+    raise AttributeError(name)
+
+
+LIMITS: dict[str, Range] = {
+    "system.geometry.d1": POSITIVE, "system.geometry.a2": POSITIVE, "system.geometry.a3": POSITIVE,
+    "system.geometry.d4": POSITIVE, "system.geometry.d5": POSITIVE, "system.geometry.d6": POSITIVE,
+    "system.conventions.snap_tol": NON_NEGATIVE, "system.conventions.s5_min": NON_NEGATIVE,
+    "system.conventions.s3_min": NON_NEGATIVE, "system.conventions.shoulder_min": NON_NEGATIVE,
+    "system.conventions.sqrt_negative_tol": NON_NEGATIVE, "system.conventions.tie_tol": NON_NEGATIVE,
+    "system.conventions.pi_sign": Range(ge=-1, le=1),
+    "system.dynamics.link_radius": POSITIVE, "system.dynamics.armature": NON_NEGATIVE,
+    "system.dynamics.damping": NON_NEGATIVE, "system.dynamics.torque_limit": POSITIVE,
+    "system.dynamics.velocity_limit": POSITIVE,
+    "scenario.ik_dt": POSITIVE, "execute.tf_dt": POSITIVE, "execute.log_dt": POSITIVE, "execute.bandwidth_hz": POSITIVE,
+    "execute.damping_ratio": POSITIVE, "scenario.poses": POSITIVE, "scenario.near_gap": NON_NEGATIVE,
+    "scenario.warmup": NON_NEGATIVE, "scenario.batch_repeats": POSITIVE,
+    "scenario.wrist.length": POSITIVE, "scenario.shoulder.length": POSITIVE, "scenario.elbow.length": POSITIVE,
+}

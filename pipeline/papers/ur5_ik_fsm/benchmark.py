@@ -1,0 +1,120 @@
+"""Speed of `ur5-ik-fsm`: the MuJoCo execution against bare stepping, and IK per call (with the
+compiled `ur-analytic-ik` as a peer when the [bench] extra is installed)."""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from math import pi
+from pathlib import Path
+
+import numpy as np
+
+from pipeline.core.checks import compose_config
+from pipeline.core.runlog import RunWriter
+from pipeline.core.timing import time_calls
+from pipeline.papers.ur5_ik_fsm import experiments as ex
+from pipeline.papers.ur5_ik_fsm import ik
+from pipeline.robotics import dh as dhk
+
+
+def _best_of(fn, repeats: int = 5) -> float:
+    best = float("inf")
+    for _ in range(repeats):
+        start = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def execution(rows: list[dict]) -> None:
+    import mujoco
+
+    cfg = compose_config(["experiment=ur5-ik-fsm/singular-paths"])
+    g = ex.geometry(cfg)
+    ik_times, poses, q_ik, _ = ex.solve_path(cfg, "wrist", "near", "alg2")
+    times, q_ref, qd_ref = ex.servo_references(q_ik, ik_times, cfg.execute.dt, True, cfg.system.dynamics.velocity_limit)
+    xml = ex.arm_model(cfg, g, q_ref[0])
+    steps, sim_seconds = len(times), float(times[-1])
+
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+
+    def bare() -> None:
+        mujoco.mj_resetData(model, data)
+        data.qpos[:] = q_ref[0]
+        step = mujoco.mj_step
+        for _ in range(steps):
+            step(model, data)
+
+    states, sensors = ex.run_servo(xml, q_ref, qd_ref, times)
+    t_bare, t_servo = _best_of(bare), _best_of(lambda: ex.run_servo(xml, q_ref, qd_ref, times))
+    system = "MuJoCo UR5, wrist path (4 s, 1 kHz)"
+    rows += [
+        {"what": system, "measure": "bare mj_step loop", "value": t_bare / steps * 1e6, "unit": "µs/step"},
+        {"what": system, "measure": "servoed run (rollout, servo in C)", "value": t_servo / steps * 1e6,
+         "unit": "µs/step"},
+    ]
+    with tempfile.TemporaryDirectory() as tmp:
+        for log_dt, label in ((cfg.execute.log_dt, "default"), (cfg.execute.dt, "every step")):
+            cfg.execute.log_dt = log_dt
+
+            def logging_only() -> None:
+                with RunWriter(Path(tmp) / "b.mcap", {"run_id": "b"}) as log:
+                    ex.log_execution(log, cfg, g, times, q_ref, qd_ref, states, sensors, ik_times, poses)
+                    log.close("ok")
+
+            def full() -> None:
+                ex.run_servo(xml, q_ref, qd_ref, times)
+                logging_only()
+
+            t_full, t_log = _best_of(full), _best_of(logging_only)
+            rate = f"log_dt = {log_dt * 1e3:g} ms ({label})"
+            rows += [
+                {"what": system, "measure": f"logging, {rate}", "value": t_log / steps * 1e6, "unit": "µs/step"},
+                {"what": system, "measure": f"servo + logging over bare mj_step, {rate}", "value": t_full / t_bare,
+                 "unit": "×", "goal": "≤ 2"},
+                {"what": system, "measure": f"simulated seconds per wall second, {rate}",
+                 "value": sim_seconds / t_full, "unit": "s/s"},
+            ]
+
+
+def ik_per_call(rows: list[dict]) -> None:
+    rng = np.random.default_rng(0)
+    n = 10_000
+    q = rng.uniform(-pi, pi, (n, 6))
+    poses = dhk.fk(dhk.DH.from_config(ik.UR5.dh), q)
+    previous = rng.uniform(-pi, pi, (n, 6))
+    inputs = list(zip(poses, previous, strict=True))
+    for name, fn, goal in (("Algorithm 1 (scalar)", ik.min_displacement, "≤ 35"),
+                           ("Algorithm 2 (scalar)", ik.fsm, "≤ 35")):
+        s = time_calls(name, fn, inputs, warmup=500).summary_us()
+        rows.append({"what": name, "measure": "per call, median (p95)", "value": s["median_us"],
+                     "p95": s["p95_us"], "unit": "µs", "goal": goal, "paper": "not reported"})
+    for alg in ("alg1", "alg2"):
+        s = time_calls(alg, lambda a=alg: ik.solve_batch(poses, previous, a), [()], warmup=2, repeats=20,
+                       items_per_call=n).summary_us()
+        rows.append({"what": f"Algorithm {alg[-1]} (batched, {n} poses)", "measure": "per pose, median (p95)",
+                     "value": s["median_us"], "p95": s["p95_us"], "unit": "µs", "goal": "≤ 2"})
+    try:
+        from ur_analytic_ik import ur5
+    except ImportError:
+        rows.append({"what": "ur-analytic-ik (C++ peer)", "measure": "not installed: pip install -e '.[bench]'",
+                     "value": float("nan"), "unit": ""})
+        return
+    # the peer uses UR's own DH values: time it on poses of its own model
+    peer_poses = [np.ascontiguousarray(ur5.forward_kinematics(*x)) for x in q]
+    for name, fn, args in (("ur-analytic-ik all solutions (C++ peer)", ur5.inverse_kinematics,
+                            [(T,) for T in peer_poses]),
+                           ("ur-analytic-ik closest (C++ peer)", ur5.inverse_kinematics_closest,
+                            [(T, *p) for T, p in zip(peer_poses, previous, strict=True)])):
+        s = time_calls(name, fn, args, warmup=500).summary_us()
+        rows.append({"what": name, "measure": "per call, median (p95)", "value": s["median_us"], "p95": s["p95_us"],
+                     "unit": "µs"})
+
+
+def benchmark() -> list[dict]:
+    rows: list[dict] = []
+    execution(rows)
+    ik_per_call(rows)
+    return rows

@@ -1,0 +1,119 @@
+"""MuJoCo models generated from a paper's parameters (never downloaded).
+
+`serial_arm` turns a standard-DH table plus link masses into an MJCF arm whose body frames are the DH
+frames: body i carries joint i about its local z (the DH z_{i-1} axis), and body i+1 sits at
+Tz(d_i)·Tx(a_i)·Rx(α_i) in it. The flange is a site at the last DH frame, so `mj_jacSite` on it is the
+geometric Jacobian of the DH model.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from pipeline.robotics.dh import DH
+
+
+def _fmt(v) -> str:
+    return " ".join(f"{x:.17g}" for x in np.atleast_1d(v))
+
+
+@dataclass(frozen=True)
+class ArmDynamics:
+    """What the DH table leaves out, as stated assumptions of the paper's config."""
+
+    masses: Sequence[float]           # kg, one per link, placed at the midpoint of the DH segment
+    link_radius: float                # m, radius of the capsule used for inertia and drawing
+    armature: Sequence[float]         # kg·m², reflected rotor inertia per joint
+    damping: Sequence[float]          # N·m·s/rad, joint viscous friction
+    torque_limit: Sequence[float]     # N·m, per joint
+
+
+def serial_arm(name: str, dh: DH, dyn: ArmDynamics, *, timestep: float, kp: Sequence[float],
+               kv: Sequence[float], gravity_compensation: bool = True) -> str:
+    """MJCF of a DH arm driven by a joint PD servo per joint, evaluated every physics step.
+
+    Controls are [q_ref (n), q̇_ref (n)]: a position actuator (gain kp) and a velocity actuator
+    (gain kv) per joint, so the joint torque is kp·(q_ref − q) + kv·(q̇_ref − q̇) (+ gravity
+    compensation), clamped to ±torque_limit at the joint.
+    """
+    n = dh.n
+    for label, seq in (("masses", dyn.masses), ("armature", dyn.armature), ("damping", dyn.damping),
+                       ("torque_limit", dyn.torque_limit), ("kp", kp), ("kv", kv)):
+        if len(seq) != n:
+            raise ValueError(f"{label} needs {n} values, got {len(seq)}")
+    gravcomp = ' gravcomp="1"' if gravity_compensation else ""
+    body_xml: list[str] = []
+    indent = "    "
+    for i in range(n):
+        seg = np.array([dh.a[i], 0.0, dh.d[i]])  # to the next DH origin, in this (rotated) body frame
+        length = float(np.linalg.norm(seg))
+        ca, sa = np.cos(dh.alpha[i] / 2), np.sin(dh.alpha[i] / 2)
+        pad = indent * (i + 2)
+        body_xml.append(f'{pad}<body name="link{i + 1}"{gravcomp}>')
+        body_xml.append(
+            f'{pad}  <joint name="joint{i + 1}" axis="0 0 1" armature="{dyn.armature[i]:.17g}" '
+            f'damping="{dyn.damping[i]:.17g}" actuatorfrcrange="{-dyn.torque_limit[i]:.17g} '
+            f'{dyn.torque_limit[i]:.17g}" ref="{-dh.theta_offset[i]:.17g}"/>')
+        if length > 1e-9:
+            body_xml.append(f'{pad}  <geom type="capsule" fromto="0 0 0 {_fmt(seg)}" size="{dyn.link_radius}" '
+                            f'mass="{dyn.masses[i]:.17g}"/>')
+        else:
+            body_xml.append(f'{pad}  <geom type="sphere" size="{dyn.link_radius}" mass="{dyn.masses[i]:.17g}"/>')
+        # child frame: Tz(d) Tx(a) Rx(alpha)
+        body_xml.append(f'{pad}  <frame pos="{_fmt(seg)}" quat="{ca:.17g} {sa:.17g} 0 0">')
+        if i == n - 1:
+            body_xml.append(f'{pad}    <site name="flange" size="0.01"/>')
+    closing = [f"{indent * (i + 2)}  </frame>\n{indent * (i + 2)}</body>" for i in reversed(range(n))]
+    actuators = "\n".join(
+        f'    <position name="pos{i + 1}" joint="joint{i + 1}" kp="{kp[i]:.17g}"/>' for i in range(n)) + "\n" + \
+        "\n".join(f'    <velocity name="vel{i + 1}" joint="joint{i + 1}" kv="{kv[i]:.17g}"/>' for i in range(n))
+    sensors = "\n".join(f'    <jointactuatorfrc name="tau{i + 1}" joint="joint{i + 1}"/>' for i in range(n))
+    joint_opts = ' actuatorgravcomp="true"' if gravity_compensation else ""
+    return f"""<mujoco model="{name}">
+  <compiler angle="radian" autolimits="true"/>
+  <option timestep="{timestep:.17g}" integrator="implicitfast"/>
+  <default>
+    <joint{joint_opts}/>
+    <geom contype="0" conaffinity="0" rgba="0.6 0.65 0.7 1"/>
+  </default>
+  <worldbody>
+    <geom type="cylinder" size="0.06 0.01" pos="0 0 -0.01" rgba="0.3 0.3 0.3 1"/>
+    <body name="base">
+{chr(10).join(body_xml)}
+{chr(10).join(closing)}
+    </body>
+  </worldbody>
+  <actuator>
+{actuators}
+  </actuator>
+  <sensor>
+{sensors}
+    <framepos name="flange_pos" objtype="site" objname="flange"/>
+    <framequat name="flange_quat" objtype="site" objname="flange"/>
+  </sensor>
+</mujoco>
+"""
+
+
+# MuJoCo does not return NaN when a simulation blows up: it warns and resets the state. These warnings
+# therefore mark a run as failed.
+_UNSTABLE = ("mjWARN_BADQACC", "mjWARN_BADQVEL", "mjWARN_BADQPOS", "mjWARN_BADCTRL")
+
+
+def check_mujoco(data, states: np.ndarray, times: np.ndarray) -> None:
+    """Raise SimulationFailed if a rollout went non-finite or MuJoCo flagged it unstable."""
+    import mujoco
+
+    from pipeline.core.runlog import SimulationFailed
+
+    if not np.isfinite(states).all():
+        bad = int(np.argmax(~np.isfinite(states).all(axis=1)))
+        raise SimulationFailed(f"state not finite at t = {times[bad]:.4g} s")
+    for name in _UNSTABLE:
+        warning = data.warning[int(getattr(mujoco.mjtWarning, name))]
+        if warning.number:
+            raise SimulationFailed(f"MuJoCo {name.removeprefix('mjWARN_')} ({warning.number}×): the simulation "
+                                   "diverged (time step too large for the gains?)")

@@ -1,0 +1,89 @@
+"""The two stage CLIs as a user meets them: bad input refused in one line with nothing written, sweeps on
+the local launcher, the Ray launcher config, divergence recorded as a failed run, determinism."""
+
+from __future__ import annotations
+
+import pytest
+from hydra import compose, initialize_config_dir
+from hydra.core.global_hydra import GlobalHydra
+
+from pipeline.core.experiment import CONF_DIR
+from pipeline.core.runlog import read_run, run_files
+
+from .conftest import run_cli
+
+SHORT_PATH = ["scenario.paths=[wrist]", "scenario.crossings=[near]", "scenario.duration=0.4"]
+
+
+@pytest.mark.parametrize(("args", "names"), [
+    (["experiment=ur5-ik-fsm/tabels"], "unknown experiment 'ur5-ik-fsm/tabels'"),
+    (["experiment=ur5-ik-fsm/tables", "scenario.tabel2=1"], "unknown config key 'scenario.tabel2'"),
+    (["experiment=ur5-ik-fsm/singular-paths", "execute.dt=0"], "execute.dt=0 is out of range: must be > 0"),
+    (["experiment=ur5-ik-fsm/singular-paths", "execute.dt=-0.001"], "execute.dt=-0.001 is out of range"),
+    (["experiment=ur5-ik-fsm/tables", "system.geometry.a2=nan"], "system.geometry.a2=nan is not a finite number"),
+    (["experiment=ur5-ik-fsm/tables", "system.geometry.d4=x"], "system.geometry.d4='x' must be a number"),
+    (["experiment=ur5-ik-fsm/tables", "+scenario.extra=1"], "adding keys is not allowed"),
+    (["-m", "experiment=ur5-ik-fsm/singular-paths", "execute.dt=0.001,0"], "execute.dt=0 is out of range"),
+    ([], "choose an experiment"),
+])
+def test_bad_input_is_refused_in_one_line(data_dir, args, names):
+    proc = run_cli("pipeline", *args, f"data_dir={data_dir}")
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and names in lines[0]
+    assert not data_dir.exists()
+
+
+@pytest.mark.parametrize(("args", "names"), [
+    (["experimnt=ur5-ik-fsm/tables"], "unknown key 'experimnt'"),
+    (["experiment=nope/x"], "unknown experiment 'nope/x'"),
+    (["stage=draw"], "stage=draw must be one of"),
+])
+def test_analysis_bad_input(data_dir, args, names):
+    proc = run_cli("analysis", *args, f"data_dir={data_dir}")
+    assert proc.returncode == 2 and names in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+    assert not data_dir.exists()
+
+
+def test_sweep_runs_one_file_per_point_in_parallel(data_dir):
+    proc = run_cli("pipeline", "-m", "experiment=ur5-ik-fsm/singular-paths", *SHORT_PATH,
+                   "scenario.algorithms=[alg2]", "execute.bandwidth_hz=6,10", f"data_dir={data_dir}")
+    assert proc.returncode == 0, proc.stderr
+    assert "LokyBackend with 2 concurrent workers" in proc.stderr  # joblib: parallel processes
+    runs = [read_run(p) for p in run_files(data_dir / "runs/ur5-ik-fsm/singular-paths")]
+    assert sorted(r.params["execute.bandwidth_hz"] for r in runs) == ["10", "6"]
+    assert all(r.ok for r in runs) and len({r.run_id for r in runs}) == 2
+
+
+def test_ray_launcher_config_composes():
+    GlobalHydra.instance().clear()
+    with initialize_config_dir(config_dir=str(CONF_DIR), version_base=None):
+        cfg = compose("config", overrides=["experiment=ur5-ik-fsm/tables", "hydra/launcher=ray"],
+                      return_hydra_config=True)
+    GlobalHydra.instance().clear()
+    assert cfg.hydra.launcher._target_.endswith("RayLauncher")
+    assert cfg.hydra.runtime.choices["hydra/launcher"] == "ray"
+
+
+def test_divergence_is_a_failed_run_and_the_stage_goes_on(data_dir):
+    # a 20 ms step under a 200 Hz servo with no torque limit blows up
+    proc = run_cli("pipeline", "experiment=ur5-ik-fsm/singular-paths", *SHORT_PATH, "execute.dt=0.02",
+                   "execute.bandwidth_hz=200", "system.dynamics.torque_limit=[1e9,1e9,1e9,1e9,1e9,1e9]",
+                   f"data_dir={data_dir}")
+    assert proc.returncode == 0
+    runs = [read_run(p) for p in run_files(data_dir / "runs/ur5-ik-fsm/singular-paths")]
+    assert len(runs) == 2
+    assert all(r.status.startswith("failed: MuJoCo BADQACC") for r in runs)
+
+
+def test_same_config_twice_gives_identical_messages(tmp_path):
+    frames = []
+    for k in range(2):
+        d = tmp_path / f"d{k}"
+        proc = run_cli("pipeline", "experiment=ur5-ik-fsm/singular-paths", *SHORT_PATH, f"data_dir={d}")
+        assert proc.returncode == 0, proc.stderr
+        frames.append([read_run(p).topics for p in run_files(d / "runs/ur5-ik-fsm/singular-paths")])
+    for a, b in zip(*frames, strict=True):
+        assert a.keys() == b.keys()
+        for topic in a:
+            assert a[topic].equals(b[topic]), topic

@@ -1,0 +1,48 @@
+"""simulate -> analyze -> report on a temporary data_dir: the report's files, its CSV contract, and the
+statuses the reproduction must reach."""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from pipeline.core.runlog import read_run, run_files
+
+from .conftest import run_cli
+
+
+def test_pipeline_to_report(data_dir):
+    for args in (["experiment=ur5-ik-fsm/tables"],
+                 ["experiment=ur5-ik-fsm/compute-time"],  # targets point at the default run
+                 ["experiment=ur5-ik-fsm/singular-paths", "scenario.paths=[wrist]", "scenario.duration=1.0"]):
+        proc = run_cli("pipeline", *args, f"data_dir={data_dir}", "progress=false")
+        assert proc.returncode == 0, proc.stderr
+    proc = run_cli("analysis", f"data_dir={data_dir}")
+    assert proc.returncode == 0, proc.stderr
+
+    report = data_dir / "report"
+    for name in ("index.md", "index.html", "ur5-ik-fsm.md", "ur5-ik-fsm.html", "targets.csv"):
+        assert (report / name).is_file(), name
+    targets = pd.read_csv(report / "targets.csv")
+    assert list(targets.columns) == ["slug", "target_id", "quantity", "where", "paper_value", "pipeline_value",
+                                     "unit", "mode", "tolerance", "status"]
+    assert set(targets["status"]) <= {"match", "close", "miss", "not-reproducible"}
+    status = targets.set_index("target_id")["status"]
+    tables = status[status.index.str.match(r"T[346]\.")]
+    assert len(tables) >= 60 + 60 + 10 and (tables == "match").all()
+    assert status["agreement"] == "match" and status["T5.4"] == "match"
+    assert status["T5.4.printed"] == "not-reproducible"
+    # the paper's smoothness claim fails on the wrist path: Algorithm 2 flips the wrist
+    assert status["claim.smooth"] == "miss"
+    assert targets.loc[targets["status"] != "not-reproducible", "pipeline_value"].notna().all()
+    assert "ur5-ik-fsm" in (report / "index.md").read_text()
+    assert list((data_dir / "figures/ur5-ik-fsm/singular-paths").glob("*.png"))
+
+    run = read_run(run_files(data_dir / "runs/ur5-ik-fsm/singular-paths")[0])
+    assert run.metadata["slug"] == "ur5-ik-fsm" and run.metadata["git_revision"]
+    assert "model.xml" in run.attachments and "config.yaml" in run.attachments
+    assert {"/joint_state", "/reference", "/command", "/tracking_error", "/tf"} <= set(run.topic_names)
+
+
+def test_analysis_of_missing_runs_says_what_to_do(data_dir):
+    proc = run_cli("analysis", "experiment=ur5-ik-fsm/tables", f"data_dir={data_dir}")
+    assert proc.returncode == 1 and "python -m pipeline experiment=ur5-ik-fsm/tables" in proc.stderr

@@ -1,0 +1,69 @@
+"""Consistency of the project's own data: DVC stages, targets files, report rules."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+import yaml
+
+from analysis.core.stages import PAPERS_DIR, analyzed_slugs, paper_package
+from analysis.core.targets import Tolerance, judge, load_targets
+from analysis.core.units import convert
+from pipeline.core.experiment import available_experiments, module_name, paper_module
+
+from .conftest import ROOT
+
+
+def test_every_experiment_is_a_dvc_stage_and_has_code():
+    dvc = yaml.safe_load((ROOT / "dvc.yaml").read_text())
+    staged = {f"{v['slug']}/{v['name']}" for v in dvc["vars"][0]["experiments"].values()}
+    assert staged == set(available_experiments())
+    for experiment in available_experiments():
+        slug, name = experiment.split("/")
+        assert name in paper_module(slug).EXPERIMENTS
+        assert name in paper_package(slug).ANALYSES
+
+
+@pytest.mark.parametrize("slug", analyzed_slugs())
+def test_targets_files_are_valid_and_point_at_real_experiments(slug):
+    targets = load_targets(PAPERS_DIR / module_name(slug) / "targets.csv")
+    live = targets[targets["mode"] != "not reproducible"]
+    assert set(live["experiment"]) <= {e.split("/")[1] for e in available_experiments() if e.startswith(slug)}
+    assert (live["metric"] != "").all() and (live["value"] != "").all()
+    info = yaml.safe_load((PAPERS_DIR / module_name(slug) / "paper.yaml").read_text())
+    assert info["slug"] == slug and info["assumptions"] and "errata" in info
+
+
+def test_judge_rules():
+    assert judge(1.00004, 1.0, "==", Tolerance(5e-5)) == "match"
+    assert judge(1.0004, 1.0, "==", Tolerance(5e-5)) == "close"
+    assert judge(1.01, 1.0, "==", Tolerance(5e-5)) == "miss"
+    assert judge(-math.pi + 1e-6, math.pi, "==", Tolerance(5e-5, wrap=True)) == "match"
+    assert judge(1.00005e7, 1e7, "==", Tolerance(1e-4, relative=True)) == "match"
+    assert judge(0.5, 1.0, "<", Tolerance()) == "match"
+    assert judge(1.05, 1.0, "<", Tolerance(0.1)) == "close"
+    assert judge(float("nan"), 1.0, "==", Tolerance(1.0)) == "miss"
+
+
+def test_units():
+    assert convert(1e-9, "m^3", "mm^3") == pytest.approx(1.0)
+    assert convert(2e-6, "s", "us") == pytest.approx(2.0)
+    with pytest.raises(ValueError):
+        convert(1.0, "m", "s")
+
+
+def test_tolerance_parse():
+    assert Tolerance.parse("1e-4 rel") == Tolerance(1e-4, relative=True)
+    assert Tolerance.parse("5e-5 wrap") == Tolerance(5e-5, wrap=True)
+    assert Tolerance.parse("") == Tolerance()
+
+
+def test_code_is_ruff_clean():
+    ruff = pytest.importorskip("ruff")
+    import subprocess
+    import sys
+
+    assert ruff
+    proc = subprocess.run([sys.executable, "-m", "ruff", "check", "."], cwd=ROOT, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stdout
