@@ -2,34 +2,19 @@
 
     python -m pipeline experiment=<slug>/<name> [key=value ...]       one experiment, one MCAP per case
     python -m pipeline -m experiment=<slug>/<name> key=a,b,c           a sweep, run in parallel (joblib)
-    python -m pipeline all                                             every configured experiment
 """
 
 from __future__ import annotations
 
+import os
 import sys
 
-
-def _run_all() -> int:
-    import subprocess
-
-    from pipeline.core.experiment import available_experiments
-
-    failed = []
-    for experiment_id in available_experiments():
-        print(f"== {experiment_id}", file=sys.stderr, flush=True)
-        code = subprocess.call([sys.executable, "-m", "pipeline", f"experiment={experiment_id}", *sys.argv[2:]])
-        if code:
-            failed.append(experiment_id)
-    if failed:
-        print(f"error: experiments with errors: {', '.join(failed)}", file=sys.stderr)
-    return 1 if failed else 0
+# One BLAS thread per process: the pipeline runs one process per core, and compute times are single-threaded.
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
 
 
 def main() -> None:
-    if sys.argv[1:2] == ["all"]:
-        sys.exit(_run_all())
-
     from pipeline.core.checks import BadInput, preflight
 
     try:

@@ -3,16 +3,15 @@ execution errors along the singular paths, per-call compute time."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from analysis.core.compute_time import compute_time_section, machine_of, timing_metrics
 from analysis.core.figures import Figures, plt
 from analysis.core.metrics import MetricTable
 from analysis.core.targets import load_targets
-from analysis.core.units import convert
 from pipeline.core.runlog import Run
 from pipeline.papers.ur5_ik_fsm.kinematics import Geometry, shoulder_term
 
@@ -190,16 +189,12 @@ def analyze_compute_time(runs: list[Run], figures: Figures) -> pd.DataFrame:
     for run in runs:
         ct = run["/compute_time"]
         counts = run["/ik/counts"]
-        values = {}
-        stats = {}
+        values, stats = {}, {}
         for alg in ALGORITHMS:
-            for name, calls in ((alg, 1), (f"{alg}_batch", None)):
-                s = ct[f"seconds.{name}"].dropna().to_numpy()
-                n = 1 if calls else int(ct[f"calls.{name}"].dropna().iloc[0])
-                per = s / n
-                stats[name] = per
-                values[f"{name}.median"] = (np.median(per), "s")
-                values[f"{name}.p95"] = (np.percentile(per, 95), "s")
+            for name in (alg, f"{alg}_batch"):
+                per_item = ct[f"seconds.{name}"].dropna().to_numpy() / ct[f"calls.{name}"].dropna().to_numpy()
+                stats[name] = per_item
+                values |= timing_metrics(name, per_item)
             values[f"{alg}.sets_evaluated_mean"] = (counts[f"value.{alg}_sets_evaluated"].mean(), "count")
         values["valid_sets.max"] = (counts["value.valid_sets"].max(), "count")
         values["valid_sets.fraction_8"] = ((counts["value.valid_sets"] == 8).mean(), "fraction")
@@ -266,17 +261,11 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
             + agree.to_frame("agreement").reset_index().to_markdown(index=False, floatfmt=".3f"))
     ct = metrics.get("compute-time")
     if ct is not None and not ct.empty:
-        run_id = ct["run_id"].iloc[0]
-        rows = [{"algorithm": name, "median [µs]": convert(_value(ct, run_id, f"{name}.median"), "s", "us"),
-                 "p95 [µs]": convert(_value(ct, run_id, f"{name}.p95"), "s", "us"),
-                 "sets built per call": _value(ct, run_id, f"{name}.sets_evaluated_mean"),
-                 "paper": "not reported"}
-                for name in ("alg1", "alg2", "alg1_batch", "alg2_batch")]
-        machine = runs.loc[runs["experiment"] == "compute-time", "machine"]
-        where = json.loads(machine.iloc[0]) if len(machine) else {}
-        sections.append(
-            "## Compute time (per call; batched: per pose)\n\n"
-            + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".3g")
-            + f"\n\nMeasured on {where.get('cpu', '?')} ({where.get('logical_cores', '?')} logical cores), "
-            "single thread, Python + NumPy, after warm-up; the paper reports no times (MATLAB R2021a).")
+        rows = [(f"Algorithm {name[3]}" + (" (batched, per pose)" if "batch" in name else " (per call)"), name,
+                 "not reported") for name in ("alg1", "alg2", "alg1_batch", "alg2_batch")]
+        sets = ", ".join(f"Algorithm {a[-1]} {_value(ct, 'random-poses', f'{a}.sets_evaluated_mean'):.2f}"
+                         for a in ALGORITHMS)
+        sections.append(compute_time_section(
+            "Compute time", ct, "random-poses", rows, machine_of(runs, "compute-time"),
+            note=f"Python + NumPy; the paper reports no times (MATLAB R2021a). Complete sets built per call: {sets}."))
     return sections
