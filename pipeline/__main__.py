@@ -17,6 +17,10 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 def main() -> None:
     from pipeline.core.checks import BadInput, preflight
 
+    # Hydra wants its flags before or after all overrides; accept -m anywhere (dvc.yaml appends it).
+    multirun = [a for a in sys.argv[1:] if a in ("-m", "--multirun")]
+    sys.argv[1:] = multirun + [a for a in sys.argv[1:] if a not in multirun]
+
     try:
         preflight(sys.argv[1:])
     except BadInput as err:
