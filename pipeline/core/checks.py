@@ -17,7 +17,7 @@ from typing import Any
 from hydra import compose, initialize_config_dir
 from hydra.core.global_hydra import GlobalHydra
 from hydra.core.override_parser.overrides_parser import OverridesParser
-from omegaconf import DictConfig, ListConfig, OmegaConf
+from omegaconf import DictConfig, ListConfig
 
 from pipeline.core.experiment import CONF_DIR, POSITIVE, POSITIVE_NAMES, Range, available_experiments, resolve
 
@@ -113,7 +113,7 @@ def preflight(argv: list[str]) -> None:
         combos = _expand(overrides)
     except BadInput:
         raise
-    except Exception as err:  # a parse error of the override syntax
+    except Exception as err:  # the override syntax itself
         raise BadInput(f"cannot parse the overrides: {str(err).splitlines()[0]}") from None
 
     known = available_experiments()
@@ -142,14 +142,3 @@ def preflight(argv: list[str]) -> None:
         _, _, _, limits = resolve(experiment)
         check_config(cfg, defaults, limits)
     GlobalHydra.instance().clear()
-
-
-def selected_experiment(cfg: DictConfig) -> str:
-    """`<slug>/<name>` of a composed config (from Hydra's record of the group choice)."""
-    from hydra.core.hydra_config import HydraConfig
-
-    return HydraConfig.get().runtime.choices["experiment"]
-
-
-def to_yaml(cfg: DictConfig) -> str:
-    return OmegaConf.to_yaml(cfg, resolve=True)
