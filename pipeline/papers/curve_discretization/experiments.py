@@ -60,6 +60,8 @@ def bezier_fig2(cfg: DictConfig) -> list[Case]:
     curve = paper_curve(cfg)
     chain = dc.Chain.uniform(cfg.system.chain.joints, cfg.system.chain.link_length)
     names = [f"joint{m}" for m in range(1, chain.joints + 1)]
+    if cfg.system.twist_hat not in ("corrected", "printed"):
+        raise ValueError(f"system.twist_hat={cfg.system.twist_hat!r} must be corrected or printed")
     printed = cfg.system.twist_hat == "printed"
 
     def simulate(log: RunWriter, theta_x0: float) -> None:
