@@ -66,11 +66,12 @@ def admittance(cfg: DictConfig, case: str, kind: str) -> np.ndarray:
 
 
 def admittance_yaml(g: PegInHole, A: np.ndarray, kind: str, info: design.Design | None = None) -> str:
+    """The admittance of a run: A (SI) and Â (length-scaled, trace n) with its eigenvalues."""
     s = design.scaling(g)
     A_hat = A / np.outer(s, s)
-    record = {"kind": kind, "dofs": TWIST_NAMES[g.dofs].tolist(), "A": A.tolist(),
-              "A_hat": (A_hat * g.n / np.trace(A_hat)).tolist(),
-              "A_hat_eigenvalues": np.linalg.eigvalsh(A_hat * g.n / np.trace(A_hat)).tolist()}
+    A_hat *= g.n / np.trace(A_hat)
+    record = {"kind": kind, "dofs": TWIST_NAMES[g.dofs].tolist(), "A": A.tolist(), "A_hat": A_hat.tolist(),
+              "A_hat_eigenvalues": np.linalg.eigvalsh(A_hat).tolist()}
     if info is not None:
         record |= {"corner_margin": info.corner_margin, "starts": info.starts, "iterations": info.iterations}
     return yaml.safe_dump(record, sort_keys=False)
@@ -142,14 +143,13 @@ def corner_conditions(cfg: DictConfig) -> list[Case]:
         keep = np.flatnonzero(subset)
         sample = design.StateSamples(interior.coords[keep], interior.W[keep], interior.d[keep], interior.v0[keep],
                                      interior.error[keep], interior.valid[keep])
-        rows = np.empty((len(A_random), 5))
+        rows = np.empty((len(A_random), 4))
         for k, A in enumerate(A_random):
             rows[k] = (corners.margin(A, speed).min(), sample.margin(A, speed).min(),
                        min(sample.margin(A, speed, slice(0, 1)).min(), corners.margin(A, speed, slice(0, 1)).min()),
-                       min(sample.margin(A, speed, slice(1, 2)).min(), corners.margin(A, speed, slice(1, 2)).min()),
-                       float(len(keep)))
+                       min(sample.margin(A, speed, slice(1, 2)).min(), corners.margin(A, speed, slice(1, 2)).min()))
         log.log_series("/conditions/random", np.arange(len(rows)) * SAMPLE_DT, schemas.Scalars, value=rows,
-                       name=["corner_min", "interior_min", "single_1_min", "single_2_min", "interior_samples"])
+                       name=["corner_min", "interior_min", "single_1_min", "single_2_min"])
 
         # compute time: one configuration per call, and one batched pass over the interior sample
         one = [(interior.W[i:i + 1], interior.d[i:i + 1], interior.v0[i:i + 1], interior.error[i:i + 1])
@@ -175,7 +175,8 @@ def corner_conditions(cfg: DictConfig) -> list[Case]:
 
 
 def log_trajectory(log: RunWriter, g: PegInHole, tr: insertion.Trajectory, speed: float, every: int) -> None:
-    """The common topics of one quasi-static trajectory, every `every`-th sample (and the last)."""
+    """The common topics of one quasi-static trajectory, every `every`-th sample (and the last); /assembly
+    holds what condition (2) is judged on along the way (dᵀv, and whether the two-point state is on)."""
     keep = np.unique(np.r_[np.arange(0, len(tr.t), every), len(tr.t) - 1])
     t = tr.t[keep]
     dofs = TWIST_NAMES[g.dofs].tolist()
@@ -207,13 +208,6 @@ def insertion_runs(cfg: DictConfig) -> list[Case]:
         tr = insertion.insert(g, A, R[0], p[0], speed=cfg.system.nominal_speed, dt=sc.dt, duration=sc.duration,
                               active_gap=sc.active_gap)
         log.metadata["outcome"] = tr.outcome
-        # error-reduction bookkeeping on every step (not only the logged ones): the analysis reads it here
-        pair = list(geometry.designated_pair(g))
-        before_end = np.arange(len(tr.t)) < len(tr.t) - 1  # the last sample is past the mated depth
-        in_state = (tr.lam[:, pair] > 0).all(axis=1) & before_end
-        log.metadata["steps"] = str(len(tr.t))
-        log.metadata["increasing_steps"] = str(int(((tr.d_dot_v > 0) & before_end).sum()))
-        log.metadata["increasing_steps_two_point"] = str(int(((tr.d_dot_v > 0) & in_state).sum()))
         log_trajectory(log, g, tr, cfg.system.nominal_speed, max(1, round(sc.log_dt / sc.dt)))
         log_pose(log, tr.t, tr.R, tr.p, sc.dt, sc.tf_dt)
         log.attach("admittance.yaml", admittance_yaml(g, A, kind), "application/yaml")

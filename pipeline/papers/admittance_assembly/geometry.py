@@ -5,8 +5,9 @@ Frames (SI): the world origin is the centre of the hole entrance, z up; the hole
 z < 0 (B = b + clearance, b the peg half-width). The body frame is the peg's: z along its axis, origin on
 the axis `ref_height` above the tip centre; the admittance A, twists v = [v_o; ω] (v_o the velocity of the
 body origin) and wrenches w = [f; m] (m about the body origin) are all expressed in it (paper eq. 1:
-"w ... measured in the body frame"). The selected point of the error measure is the tip centre; it is
-mated at (0, 0, -depth) with the peg upright.
+"w ... measured in the body frame"). The selected point of the error measure is on the axis
+`selected_height` above the tip centre (default: the tip centre); it is mated when the peg is upright and
+its tip centre at (0, 0, -depth).
 
 The planar case is the x-z section: the peg moves in (x, z, rotation about y); its twists keep the
 components `PLANAR_DOFS` = (v_x, v_z, ω_y) of the spatial ones, so one code path serves both.
@@ -103,7 +104,7 @@ class _Candidate:
     name: str
     kind: str                 # vertex-wall | rim-face | edge-edge
     body: np.ndarray          # body point: the vertex, the face's outward normal (rim-face), the edge's base
-    world: np.ndarray         # wall normal into the hole (vertex-wall), rim point / rim edge start
+    world: np.ndarray         # vertex-wall: the wall's normal, into the hole (zeros for the other kinds)
     axis: int                 # hole axis of the wall / rim (0: x, 1: y)
     side: float               # +1 or -1: which wall / rim along `axis`
 
@@ -207,7 +208,7 @@ def unit_wrenches(g: PegInHole, R: np.ndarray, p: np.ndarray, point: np.ndarray,
 
 
 def error_vector(g: PegInHole, R: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """(N, 3) δ = tip centre − its mated position, world frame."""
+    """(N, 3) δ = the selected point − its mated position, world frame."""
     R, p = np.asarray(R, float).reshape(-1, 3, 3), np.asarray(p, float).reshape(-1, 3)
     return R @ g.selected_point + p - g.mated_point
 
@@ -295,7 +296,7 @@ def se3_step(R: np.ndarray, p: np.ndarray, twist: np.ndarray, dt: float) -> tupl
     v, w = twist[:3] * dt, twist[3:] * dt
     angle = float(np.sqrt(w @ w))
     K = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
-    if angle < 1e-9:  # series of the Rodrigues coefficients
+    if angle < 1e-4:  # series of the coefficients: the closed forms cancel catastrophically for small angles
         a, b, c = 1.0 - angle ** 2 / 6, 0.5 - angle ** 2 / 24, 1.0 / 6 - angle ** 2 / 120
     else:
         a, b, c = np.sin(angle) / angle, (1 - np.cos(angle)) / angle ** 2, (angle - np.sin(angle)) / angle ** 3

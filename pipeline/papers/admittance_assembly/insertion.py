@@ -64,10 +64,9 @@ def insert(g: PegInHole, A: np.ndarray, R0: np.ndarray, p0: np.ndarray, *, speed
     for k in range(steps + 1):
         lam, w, v, c = predicted_response(g, A, R, p, speed, active_gap, dt)
         R_log[k], p_log[k], v_log[k], w_log[k], lam_log[k], gap_log[k] = R, p, v, w, lam, c.gap[0]
-        tip_z = (R @ g.selected_point + p)[2]
         if not np.isfinite(v).all():
             raise SimulationFailed(f"non-finite twist at t = {k * dt:.4g} s")
-        if tip_z <= g.mated_point[2]:
+        if (R @ g.selected_point + p)[2] <= g.mated_point[2]:
             outcome = "inserted"
             break
         if (R @ np.array([0.0, 0.0, -g.ref_height]) + p)[2] > 0.0:
