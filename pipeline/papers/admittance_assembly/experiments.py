@@ -21,6 +21,7 @@ from pipeline.papers.admittance_assembly.geometry import PegInHole
 TWIST_NAMES = np.array(["v_x", "v_y", "v_z", "w_x", "w_y", "w_z"])
 ERROR_NAMES = ["x", "y", "z"]
 SAMPLE_DT = 1e-3  # s: samples that are not a trajectory (configurations, admittances) are logged 1 ms apart
+NEAR_GAP = 1e-4   # m: a MuJoCo contact is attributed to the nearest candidate within this gap
 
 
 # -- configuration -> model -----------------------------------------------------------------------------
@@ -275,9 +276,6 @@ def mujoco_crosscheck(cfg: DictConfig) -> list[Case]:
 
     return [Case(f"{case}-{run}", lambda log, c=case, r=run: simulate(log, c, r))
             for case in sc.cases for run in sc.runs]
-
-
-NEAR_GAP = 1e-4  # m: a MuJoCo contact is attributed to the nearest candidate within this gap
 
 
 def _mujoco_sample(sim, g: PegInHole, A: np.ndarray, R, p, v0, t: float, predict_gap: float) -> dict:
