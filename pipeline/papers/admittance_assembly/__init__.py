@@ -1,0 +1,58 @@
+"""`admittance-assembly`: Huang, Schimmels — Admittance Selection Conditions for Frictionless Force-Guided
+Assembly of Polyhedral Parts in Two Single-Point Principal Contacts (IEEE T-RO 2008).
+
+The paper's text is truncated after its introduction: what survives is the admittance law v = v0 + A·w (1)
+and the error-reduction condition dᵀ(v0 + A·w) < 0 (2). This package is the demonstrator of the spec: a
+square peg in a square hole, frictionless and quasi-static, in the two-point contact state (planar and
+spatial). The importable API (SI units, body-frame twists [v; ω] and wrenches [f; m]):
+
+    PegInHole(planar, half_width, length, ref_height, clearance, depth)   the geometry of one case
+    contacts(g, R, p) -> Contacts                 every candidate contact: gap, point, normal
+    unit_wrenches(g, R, p, points, normals)       the columns of W (w = W λ), body frame
+    line_vector(g, R, p)                          d of eq. (2)
+    contact_response(A, W, v0) -> (λ, w, v)       the frictionless complementarity problem under eq. (1)
+    solve_lcp(M, q)                               λ ≥ 0, Mλ + q ≥ 0, λᵀ(Mλ + q) = 0
+    state_samples(g, coords, speed).margin(A, speed)   condition (2) over chart coordinates of the state
+    design_admittance(...)                        an A that maximises the worst margin at given configurations
+    insert(g, A, R0, p0, ...)                     a quasi-static insertion
+"""
+
+from __future__ import annotations
+
+from pipeline.core.experiment import ANGLE, NON_NEGATIVE, POSITIVE, Range
+from pipeline.papers.admittance_assembly.design import design_admittance, state_samples
+from pipeline.papers.admittance_assembly.geometry import PegInHole, contacts, line_vector, unit_wrenches
+from pipeline.papers.admittance_assembly.insertion import insert
+from pipeline.papers.admittance_assembly.quasistatic import contact_response, solve_lcp
+
+__all__ = ["PegInHole", "contact_response", "contacts", "design_admittance", "insert", "line_vector", "solve_lcp",
+           "state_samples", "unit_wrenches"]
+
+
+def __getattr__(name: str):
+    # the experiments pull in MuJoCo, Hydra's config objects and the run writer
+    if name == "EXPERIMENTS":
+        from pipeline.papers.admittance_assembly import experiments
+
+        return {"corner-conditions": experiments.corner_conditions, "insertion": experiments.insertion_runs,
+                "mujoco-crosscheck": experiments.mujoco_crosscheck}
+    raise AttributeError(name)
+
+
+_BOX = {"tilt": ANGLE, "tilt_x": ANGLE, "twist": ANGLE, "lateral": Range(ge=-0.01, le=0.01),
+        "clearance": Range(gt=0, le=0.01)}
+LIMITS: dict[str, Range] = {
+    "system.peg.half_width": Range(gt=0, le=1.0), "system.peg.length": Range(gt=0, le=2.0),
+    "system.peg.ref_height": Range(ge=-2.0, le=2.0), "system.hole.clearance": Range(gt=0, le=0.01),
+    "system.hole.depth": POSITIVE, "system.selected_height": Range(ge=-2.0, le=2.0),
+    "system.nominal_speed": POSITIVE, "system.admittance.translational": POSITIVE,
+    "system.admittance.min_eigenvalue": Range(gt=0, lt=1), "system.admittance.restarts": NON_NEGATIVE,
+    **{f"system.state.{case}.{key}": r for case in ("planar", "spatial") for key, r in _BOX.items()},
+    "scenario.interior_samples": POSITIVE, "scenario.random_admittances": POSITIVE,
+    "scenario.random_interior_samples": POSITIVE, "scenario.timing_repeats": POSITIVE, "scenario.trials": POSITIVE,
+    "scenario.active_gap": POSITIVE, "scenario.predict_gap": POSITIVE, "scenario.log_dt": POSITIVE,
+    "scenario.tf_dt": POSITIVE,
+    "scenario.insertion_dt": POSITIVE, "scenario.static_duration": POSITIVE, "scenario.settle": NON_NEGATIVE,
+    "scenario.static_forces": POSITIVE,
+    "mujoco.timestep": POSITIVE, "mujoco.solref": POSITIVE, "mujoco.solimp": Range(ge=0, le=10),
+}
