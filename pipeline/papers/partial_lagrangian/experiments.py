@@ -170,10 +170,11 @@ def compute_time(cfg: DictConfig) -> list[Case]:
             add_evaluation(f"terms.column.n{n}", last_column, (q, qd))
             builds[f"build.column.n{n}"] = (lg.column_mass_bias, (chain, n - 1), 1)
             model = mujoco.MjModel.from_xml_string(chain_model(chain, cfg.system.simulation.dt))
-            state = np.zeros((sc.mujoco_batch, mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS)))
-            state[:, 1:1 + n], state[:, 1 + n:1 + 2 * n] = q[:sc.mujoco_batch], qd[:sc.mujoco_batch]
+            batch = min(sc.mujoco_batch, sc.states)
+            state = np.zeros((batch, mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS)))
+            state[:, 1:1 + n], state[:, 1 + n:1 + 2 * n] = q[:batch], qd[:batch]
             evaluations[f"eval.mujoco.n{n}"] = (partial(rollout.rollout, nstep=1),
-                                                (model, mujoco.MjData(model), state), sc.mujoco_batch)
+                                                (model, mujoco.MjData(model), state), batch)
             sizes.append([n, dyn["full"].mass_bias.n_instructions(), dyn["partial"].mass_bias.n_instructions(),
                           last_column.n_instructions(), dyn["full"].inverse.n_instructions(),
                           dyn["partial"].inverse.n_instructions()])
@@ -211,9 +212,9 @@ def checks(cfg: DictConfig) -> list[Case]:
     def relative(a, b) -> float:
         return float(np.abs(np.asarray(a) - b).max() / max(np.abs(b).max(), 1e-300))
 
-    def simulate_case(log: RunWriter, key: str) -> None:
+    def simulate_case(log: RunWriter, key: str, index: int) -> None:
         chain, dt = chains[key], cfg.system.simulation.dt
-        rng = np.random.default_rng([cfg.seed, chain.n, len(key)])
+        rng = np.random.default_rng([cfg.seed, index])
         q, qd, tau = random_states(rng, chain.n, sc.states)
         q0 = np.zeros(chain.n)
         if key == "slider":
@@ -251,4 +252,4 @@ def checks(cfg: DictConfig) -> list[Case]:
             e = ch.energies(chain.undamped(), free.q[logged], free.qd[logged])
             log.log_series(f"/energy/{integrator}", free.t[logged], schemas.Scalars, name=["total"], value=e["total"])
 
-    return [Case(key, lambda log, k=key: simulate_case(log, k)) for key in chains]
+    return [Case(key, lambda log, k=key, i=i: simulate_case(log, k, i)) for i, key in enumerate(chains)]
