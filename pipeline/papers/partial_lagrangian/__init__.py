@@ -15,15 +15,25 @@ The importable API (SI units; planar chains of point masses, angles from +x, rel
 
 from __future__ import annotations
 
-from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, Range
-from pipeline.papers.partial_lagrangian.chain import Chain, double_pendulum, energies, gravity_torque, planar_chain
+from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, OneOf, Range
+from pipeline.papers.partial_lagrangian.chain import (
+    DAMPING_MODELS,
+    PRISMATIC,
+    REVOLUTE,
+    Chain,
+    double_pendulum,
+    energies,
+    gravity_torque,
+    planar_chain,
+)
 from pipeline.papers.partial_lagrangian.lagrangian import (
+    FORMS,
     column_mass_bias,
     dynamics,
     equations_of_motion,
     listing_a1_step,
 )
-from pipeline.papers.partial_lagrangian.rollout import Gains, Trajectory, simulate
+from pipeline.papers.partial_lagrangian.rollout import INTEGRATORS, Gains, Trajectory, simulate
 
 __all__ = ["Chain", "Gains", "Trajectory", "column_mass_bias", "double_pendulum", "dynamics", "energies",
            "equations_of_motion", "gravity_torque", "listing_a1_step", "planar_chain", "simulate"]
@@ -44,7 +54,10 @@ def __getattr__(name: str):
 
 
 LINKS = Range(ge=1, le=10)   # the configured parameter lists hold 10 links (Sect. 4: up to 10 DoF)
-LIMITS: dict[str, Range] = {
+LIMITS: dict[str, Range | OneOf] = {
+    "system.damping_model": OneOf(DAMPING_MODELS), "system.simulation.formulation": OneOf(FORMS),
+    "system.simulation.integrator": OneOf(INTEGRATORS), "scenario.joints": OneOf((REVOLUTE, PRISMATIC)),
+    "scenario.cases": OneOf(("free", "pd")),
     "system.gravity": NON_NEGATIVE, "system.links.mass": POSITIVE, "system.links.length": POSITIVE,
     "system.links.damping": NON_NEGATIVE, "system.links.stiffness": NON_NEGATIVE,
     "system.logging.log_dt": POSITIVE, "system.logging.tf_dt": POSITIVE,
