@@ -168,11 +168,8 @@ def listing_a1_step(chain: Chain) -> ca.Function:
     lacc = dl_dth - dr_domega + tau         # the control input written into the generalized force
     balance_ = dl_dt - lacc                 # T
     inertia = adjoint(balance_, "acc")      # 4.-5. T.backward(); I = acc.grad
-    acc_new = lacc / inertia
-    nodes = {om: om0 + acc_prev * dt}
-    nodes[th] = th0 + nodes[om] * dt
-    nodes[acc] = acc_prev
-    values = ca.substitute([acc_new, nodes[th], nodes[om]], [th, om, acc], [nodes[th], nodes[om], nodes[acc]])
-    acc_value, theta, omega = values
+    omega_node = om0 + acc_prev * dt        # 0. the registered nodes, at the stored acc
+    theta_node = th0 + omega_node * dt
+    acc_value = ca.substitute(lacc / inertia, ca.vertcat(th, om, acc), ca.vertcat(theta_node, omega_node, acc_prev))
     return ca.Function("listing_a1_step", [th0, om0, acc_prev, tau, dt],
-                       [theta, omega + acc_value * dt, acc_value])  # omega += acc * dt
+                       [theta_node, omega_node + acc_value * dt, acc_value])  # acc = lacc / I; omega += acc * dt
