@@ -87,3 +87,18 @@ def test_same_config_twice_gives_identical_messages(tmp_path):
         assert a.keys() == b.keys()
         for topic in a:
             assert a[topic].equals(b[topic]), topic
+
+
+def test_choice_parameters_are_checked():
+    from omegaconf import OmegaConf
+
+    from pipeline.core.checks import BadInput, check_config
+    from pipeline.core.experiment import OneOf
+
+    defaults = OmegaConf.create({"mode": "x", "joints": ["p", "q"]})
+    limits = {"mode": OneOf(("x", "y")), "joints": OneOf(("p", "q"))}
+    check_config(OmegaConf.create({"mode": "y", "joints": ["q"]}), defaults, limits)
+    with pytest.raises(BadInput, match=r"mode='z' is not allowed: must be one of x, y"):
+        check_config(OmegaConf.create({"mode": "z", "joints": ["p"]}), defaults, limits)
+    with pytest.raises(BadInput, match=r"joints\[1\]='r' is not allowed"):
+        check_config(OmegaConf.create({"mode": "x", "joints": ["p", "r"]}), defaults, limits)

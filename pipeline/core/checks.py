@@ -19,7 +19,7 @@ from hydra.core.global_hydra import GlobalHydra
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from omegaconf import DictConfig, ListConfig
 
-from pipeline.core.experiment import CONF_DIR, POSITIVE, POSITIVE_NAMES, Range, available_experiments, resolve
+from pipeline.core.experiment import CONF_DIR, POSITIVE, POSITIVE_NAMES, OneOf, Range, available_experiments, resolve
 
 NO_PREFLIGHT_FLAGS = {"--help", "-h", "--hydra-help", "--info", "-i", "--shell-completion", "-sc"}
 SWEEP_LIMIT = 10_000
@@ -44,13 +44,16 @@ def _is_number(x: Any) -> bool:
     return isinstance(x, int | float) and not isinstance(x, bool)
 
 
-def check_config(cfg: DictConfig, defaults: DictConfig, limits: dict[str, Range]) -> None:
+def check_config(cfg: DictConfig, defaults: DictConfig, limits: dict[str, Range | OneOf]) -> None:
     """Raise BadInput for the first value that is not a finite number where a number belongs, has the
-    wrong type, or lies outside its range."""
+    wrong type, lies outside its range, or is not one of a choice's values."""
     default_values = dict(_leaves(defaults))
     for key, value in _leaves(cfg):
         if key.startswith("hydra."):
             continue
+        choice = limits.get(key.split("[")[0])
+        if isinstance(choice, OneOf) and value not in choice:
+            raise BadInput(f"{key}={value!r} is not allowed: must be {choice}")
         default = default_values.get(key)
         if _is_number(default) and not _is_number(value):
             raise BadInput(f"{key}={value!r} must be a number (default {default})")

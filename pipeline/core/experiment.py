@@ -3,7 +3,7 @@
 A paper package `pipeline.papers.<slug with _>` exports
 
     EXPERIMENTS: dict[str, Callable[[DictConfig], list[Case]]]   # one entry per conf/experiment/<slug>/<name>.yaml
-    LIMITS: dict[str, Range]                                     # physical ranges of its parameters (optional)
+    LIMITS: dict[str, Range | OneOf]                             # physical ranges / allowed choices (optional)
 
 An experiment turns its resolved config into cases; each case is one run, one MCAP file.
 """
@@ -54,6 +54,19 @@ class Range:
         return " and ".join(parts)
 
 
+@dataclass(frozen=True)
+class OneOf:
+    """The allowed values of a choice parameter (each element, for a list)."""
+
+    values: tuple[str, ...]
+
+    def __contains__(self, x: object) -> bool:
+        return x in self.values
+
+    def __str__(self) -> str:
+        return "one of " + ", ".join(self.values)
+
+
 POSITIVE = Range(gt=0)
 NON_NEGATIVE = Range(ge=0)
 PROBABILITY = Range(ge=0, le=1)
@@ -77,7 +90,7 @@ def available_experiments() -> list[str]:
     return sorted(str(p.relative_to(root).with_suffix("")) for p in root.glob("*/*.yaml"))
 
 
-def resolve(experiment_id: str) -> tuple[str, str, ExperimentFn, dict[str, Range]]:
+def resolve(experiment_id: str) -> tuple[str, str, ExperimentFn, dict[str, Range | OneOf]]:
     """`<slug>/<name>` -> (slug, name, experiment function, parameter limits)."""
     slug, _, name = experiment_id.partition("/")
     module = paper_module(slug)

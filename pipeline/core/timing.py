@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import gc
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -74,3 +74,27 @@ def log_timings(log: RunWriter, timings: Sequence[Timing], start: float = 0.0, s
                        seconds=timing.seconds[:, None])
         t = float(times[-1]) + spacing
     return t
+
+
+def time_interleaved(calls: Mapping[str, tuple[Callable[..., Any], tuple, int]], *, warmup: int = 1,
+                     repeats: int = 1) -> dict[str, Timing]:
+    """Time several calls in rounds, each round calling every one once in turn, so that a change of load
+    on a shared machine during the measurement falls on all of them alike (what ratios between
+    algorithms and scaling fits need). `calls` maps name -> (fn, args, items_per_call)."""
+    for fn, args, _ in calls.values():
+        for _ in range(warmup):
+            fn(*args)
+    clock = time.perf_counter_ns
+    samples = {name: np.empty(repeats) for name in calls}
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        for r in range(repeats):
+            for name, (fn, args, _) in calls.items():
+                start = clock()
+                fn(*args)
+                samples[name][r] = clock() - start
+    finally:
+        if enabled:
+            gc.enable()
+    return {name: Timing(name, samples[name] * 1e-9, items) for name, (_, _, items) in calls.items()}

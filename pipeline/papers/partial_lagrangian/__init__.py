@@ -1,0 +1,72 @@
+"""`partial-lagrangian`: Kusaka, Tanaka — Partial Lagrangian for Efficient Extension and Reconstruction
+of Multi-DoF Systems and Efficient Analysis Using Automatic Differentiation (Robotics 2022, 11, 149).
+
+The importable API (SI units; planar chains of point masses, angles from +x, relative after link 1):
+
+    planar_chain(n, mass, length, damping, stiffness, gravity, ...) -> Chain
+    dynamics(chain, form="partial"|"full") -> Dynamics      CasADi functions: forward (q, q̇, τ) -> q̈,
+                                                             mass_bias (q, q̇) -> (M, b), inverse (q, q̇, q̈) -> τ
+    equations_of_motion(chain, form) -> Function            (q, q̇) -> (M, b) only
+    column_mass_bias(chain, i) -> Function                  column i of Table 1 alone (eq. 5)
+    listing_a1_step(chain) -> Function                      one step of the paper's Listing A1 (one DoF)
+    simulate(chain, q0, q̇0, gains, dt, duration) -> Trajectory   PID-controlled run (rollout.Gains)
+    MujocoChain(chain)                                       the same chain in MuJoCo (independent check)
+"""
+
+from __future__ import annotations
+
+from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, OneOf, Range
+from pipeline.papers.partial_lagrangian.chain import (
+    DAMPING_MODELS,
+    PRISMATIC,
+    REVOLUTE,
+    Chain,
+    double_pendulum,
+    energies,
+    gravity_torque,
+    planar_chain,
+)
+from pipeline.papers.partial_lagrangian.lagrangian import (
+    FORMS,
+    column_mass_bias,
+    dynamics,
+    equations_of_motion,
+    listing_a1_step,
+)
+from pipeline.papers.partial_lagrangian.rollout import INTEGRATORS, Gains, Trajectory, simulate
+
+__all__ = ["Chain", "Gains", "Trajectory", "column_mass_bias", "double_pendulum", "dynamics", "energies",
+           "equations_of_motion", "gravity_torque", "listing_a1_step", "planar_chain", "simulate"]
+
+
+def __getattr__(name: str):
+    # The experiments pull in MuJoCo and the MCAP writer; the dynamics above need only CasADi and NumPy.
+    if name == "EXPERIMENTS":
+        from pipeline.papers.partial_lagrangian import experiments as ex
+
+        return {"one-link": ex.pendulum, "two-link": ex.pendulum, "three-link": ex.pendulum,
+                "ten-link": ex.pendulum, "slider": ex.slider, "compute-time": ex.compute_time, "checks": ex.checks}
+    if name == "MujocoChain":
+        from pipeline.papers.partial_lagrangian.mujoco_chain import MujocoChain
+
+        return MujocoChain
+    raise AttributeError(name)
+
+
+LINKS = Range(ge=1, le=10)   # the configured parameter lists hold 10 links (Sect. 4: up to 10 DoF)
+LIMITS: dict[str, Range | OneOf] = {
+    "system.damping_model": OneOf(DAMPING_MODELS), "system.simulation.formulation": OneOf(FORMS),
+    "system.simulation.integrator": OneOf(INTEGRATORS), "scenario.joints": OneOf((REVOLUTE, PRISMATIC)),
+    "scenario.cases": OneOf(("free", "pd")),
+    "system.gravity": NON_NEGATIVE, "system.links.mass": POSITIVE, "system.links.length": POSITIVE,
+    "system.links.damping": NON_NEGATIVE, "system.links.stiffness": NON_NEGATIVE,
+    "system.logging.log_dt": POSITIVE, "system.logging.tf_dt": POSITIVE,
+    "scenario.links": LINKS, "scenario.slider_angle_deg": Range(ge=-360, le=360),
+    "scenario.free.duration": POSITIVE, "scenario.pd.duration": POSITIVE, "scenario.duration": POSITIVE,
+    "scenario.pd.kp": NON_NEGATIVE, "scenario.pd.kd": NON_NEGATIVE, "scenario.pd.reference_deg": Range(ge=-360, le=360),
+    "scenario.pid.kp": NON_NEGATIVE, "scenario.pid.ki": NON_NEGATIVE, "scenario.pid.kd": NON_NEGATIVE,
+    "scenario.pid.reference": POSITIVE, "scenario.states": POSITIVE, "scenario.eval_repeats": POSITIVE,
+    "scenario.build_repeats": POSITIVE, "scenario.warmup": NON_NEGATIVE, "scenario.batch_instructions": POSITIVE,
+    "scenario.mujoco_batch": POSITIVE,
+    "scenario.trajectory_duration": POSITIVE, "scenario.energy_duration": POSITIVE,
+}
