@@ -115,6 +115,10 @@ class Drive:
     with eq. (7) (erratum: as printed the loop would push the gripper away from its set point).
     """
 
+    __slots__ = ("A_1", "A_2", "I_1", "I_2", "I_max", "I_ref_1", "I_ref_2", "K_c1", "K_c2", "K_e_1", "K_e_2", "K_t",
+                 "U_1", "U_2", "U_max", "current_abs", "current_ff", "decay", "direction", "g_1", "g_2", "g_s", "gain",
+                 "limit_A", "limit_I", "omega_1_limit", "omega_ref", "p", "phi_sr", "voltage_ff")
+
     def __init__(self, p: Gripper, s: Schedule, I_1=0.0, I_2=0.0, phi_g=0.0):
         self.p = p
         # per-tick inputs as Python floats, or rows of a batch (list indexing is the fastest per-step access)
@@ -124,6 +128,9 @@ class Drive:
         self.phi_sr = _rows(s.phi_sr)
         self.direction = _rows(np.sign(s.current))                        # of the grasp current: + closes
         self.current_abs = _rows(np.abs(s.current))
+        # constants of the 50 µs tick, as attributes of the drive (one lookup each)
+        self.K_c1, self.K_c2, self.K_t, self.U_max, self.I_max = p.K_c1, p.K_c2, p.K_t, p.U_max, p.I_max
+        self.K_e_1, self.K_e_2 = p.K_e, p.K_e * p.gear.g_c               # M2 turns at g_c ω_g (drive's direction)
         # exact solution of the winding L dI/dt = U − R I − K_e ω over one tick at constant U, ω
         self.decay = math.exp(-p.dt * p.R / p.L)
         self.gain = (1.0 - self.decay) / p.R
@@ -156,21 +163,22 @@ class Drive:
             self.limit_A = 0.5 * (A + cap - abs(A - cap))                               # min(A, |I_cmd|)
             u = p.speed_gain * e + self.limit_A
             self.limit_I = 0.5 * (u + cap - abs(u - cap))                               # min(u, |I_cmd|)
+        # the 50 µs part, _clip written out (a call per clip costs as much as the arithmetic)
+        I_max, U_max = self.I_max, self.U_max
         I_cmd = self.current_ff[k] - self.direction[k] * (self.current_abs[k] - self.limit_I)
-        I_ref_1 = _clip(I_cmd, p.I_max)
-        self.I_ref_1 = I_ref_1
+        self.I_ref_1 = I_ref_1 = 0.5 * (abs(I_cmd + I_max) - abs(I_cmd - I_max))
         # eqs. (13), (15), (17): PI with the back-EMF feed-forward; the integrator stops while U saturates
         e_1 = I_ref_1 - self.I_1
-        u_1 = p.K_c1 * e_1 + self.A_1 + self.voltage_ff[k]
-        U_1 = _clip(u_1, p.U_max)
-        self.A_1 = self.A_1 + self.g_1 * e_1 * (abs(u_1) <= p.U_max)
+        u_1 = self.K_c1 * e_1 + self.A_1 + self.voltage_ff[k]
+        self.U_1 = U_1 = 0.5 * (abs(u_1 + U_max) - abs(u_1 - U_max))
+        self.A_1 += self.g_1 * e_1 * (abs(u_1) <= U_max)
         # eqs. (14), (16), (18)
         e_2 = self.I_ref_2 - self.I_2
-        u_2 = p.K_c2 * e_2 + self.A_2
-        U_2 = _clip(u_2, p.U_max)
-        self.A_2 = self.A_2 + self.g_2 * e_2 * (abs(u_2) <= p.U_max)
-        self.U_1, self.U_2 = U_1, U_2
-        # windings over the tick (M2's speed in the drive's direction is g_c ω_g)
-        self.I_1 = self.decay * self.I_1 + self.gain * (U_1 - p.K_e * omega_1)
-        self.I_2 = self.decay * self.I_2 + self.gain * (U_2 - p.K_e * p.gear.g_c * omega_g)
-        return p.K_t * self.I_1, p.K_t * self.I_2
+        u_2 = self.K_c2 * e_2 + self.A_2
+        self.U_2 = U_2 = 0.5 * (abs(u_2 + U_max) - abs(u_2 - U_max))
+        self.A_2 += self.g_2 * e_2 * (abs(u_2) <= U_max)
+        # windings over the tick
+        decay, gain = self.decay, self.gain
+        self.I_1 = I_1 = decay * self.I_1 + gain * (U_1 - self.K_e_1 * omega_1)
+        self.I_2 = I_2 = decay * self.I_2 + gain * (U_2 - self.K_e_2 * omega_g)
+        return self.K_t * I_1, self.K_t * I_2

@@ -16,7 +16,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from pipeline.core import schemas
 from pipeline.core.experiment import Case
-from pipeline.core.runlog import RunWriter
+from pipeline.core.runlog import RunWriter, SimulationFailed
 from pipeline.papers.gripper_force_control import lumped
 from pipeline.papers.gripper_force_control.drive import Schedule, move_duration, schedule
 from pipeline.papers.gripper_force_control.lumped import Start, Trace, static_grasp
@@ -28,7 +28,7 @@ PLANTS = ("mujoco", "lumped")
 
 TableRow = schemas.define(
     "GripperTableRow", "One row of a comparison table of the gripper paper (datasheet values as printed).",
-    table="string", gripper="string", name="string[]", value="double[]", printed="string",
+    table="string", gripper="string", name="string[]", value="double[]",
 )
 GraspSample = schemas.define(
     "GripperGraspSample", "The random draws of Monte-Carlo grasps: approach gap (m) and M1 Coulomb friction (N m).",
@@ -40,7 +40,7 @@ GraspSample = schemas.define(
 
 
 def run_plant(log: RunWriter, cfg: DictConfig, p: Gripper, s: Schedule, start: Start, plant: str,
-              open_stop: float | None = None) -> Trace:
+              open_stop: float | None = None) -> None:
     """Simulate one run on `plant` and log it (and, for MuJoCo, the generated model and the body poses).
     `open_stop`: MuJoCo's finger stops there when opening (the lumped plant has no stops)."""
     log_every = max(1, round(cfg.log_dt / p.dt))
@@ -55,11 +55,8 @@ def run_plant(log: RunWriter, cfg: DictConfig, p: Gripper, s: Schedule, start: S
     else:
         raise ValueError(f"plant={plant!r}: one of {PLANTS}")
     if not np.isfinite(trace["force"]).all():
-        from pipeline.core.runlog import SimulationFailed
-
         raise SimulationFailed("grasp force not finite")
     log_trace(log, p, s, trace, log_every)
-    return trace
 
 
 def log_trace(log: RunWriter, p: Gripper, s: Schedule, trace: Trace, log_every: int) -> None:
@@ -70,7 +67,7 @@ def log_trace(log: RunWriter, p: Gripper, s: Schedule, trace: Trace, log_every: 
         force, commanded = force[:, None], commanded[:, None]
         names = ["grasp"]
     else:
-        names = [f"grasp{i:02d}" for i in range(force.shape[1])]
+        names = [f"grasp{i:03d}" for i in range(force.shape[1])]
     zero = np.zeros_like(force)
     for topic, value in (("/wrench", force), ("/wrench/commanded", commanded)):
         log.log_series(topic, t, frame_id="pad", name=names, force_x=value, force_y=zero, force_z=zero,
@@ -194,11 +191,9 @@ def tables(cfg: DictConfig) -> list[Case]:
         for table, rows in sc.tables.items():
             columns = list(rows.columns)
             for gripper_name, values in rows.rows.items():
-                numbers = [float("nan") if isinstance(v, str) else float(v) for v in values]
-                printed = " | ".join(str(v) for v in values)
-                log.log("/tables", t, TableRow, table=table, gripper=gripper_name, name=columns, value=numbers,
-                        printed=printed)
-                t += 1e-3
+                log.log("/tables", t, TableRow, table=table, gripper=gripper_name, name=columns,
+                        value=[float(v) for v in values])
+                t += 1e-3   # one row per millisecond: a table is a sequence of records, not a trajectory
         p = gripper(cfg.system)
         printed_ff = gripper(OmegaConf.merge(cfg.system, {"controller": {"feedforward": "printed"}}))
         g = p.gear

@@ -65,7 +65,8 @@ def contact_force(p: Gripper, phi_f, omega_f):
 
 
 def accelerations(p: Gripper, tau_1, tau_2, phi_1, omega_1, phi_g, omega_g, tau_fr_1=0.0, tau_fr_g=0.0):
-    """(ω̇_1, ω̇_g, F): the continuous model above, for given motor torques and friction torques."""
+    """(ω̇_1, ω̇_g, F): the continuous model above, for given motor torques and friction torques (`simulate`
+    passes none and solves the friction per tick)."""
     kg, n = p.gear.k_g, p.gear.g_f
     F = contact_force(p, (phi_1 - kg * phi_g) / n, (omega_1 - kg * omega_g) / n)
     return ((tau_1 - F * p.l_f / n - tau_fr_1) / p.J_1,
@@ -74,11 +75,9 @@ def accelerations(p: Gripper, tau_1, tau_2, phi_1, omega_1, phi_g, omega_g, tau_
 
 def simulate(p: Gripper, s: Schedule, start: Start, log_every: int) -> Trace:
     """Run the drive and the lumped plant over the schedule; sample every `log_every` ticks."""
-    kg, n, lf, h = p.gear.k_g, p.gear.g_f, p.l_f, p.dt
-    J_1, J_g, g_c = p.J_1, p.J_g, p.gear.g_c
-    k_c, c_c = p.k_c, p.c_c
-    hold_1, hold_g = J_1 / h, J_g / h            # friction torque that stops the axis within one tick
-    visc_1, visc_g = 1.0 + h * p.b_1 / J_1, 1.0 + h * p.b_g / J_g
+    kg, n, h = p.gear.k_g, p.gear.g_f, p.dt
+    hold_1, hold_g = p.J_1 / h, p.J_g / h        # friction torque that stops the axis within one tick
+    visc_1, visc_g = 1.0 + h * p.b_1 / p.J_1, 1.0 + h * p.b_g / p.J_g
     tau_c1, tau_cg = p.tau_c1, p.tau_cg
     zero = np.zeros_like(np.asarray(start.phi_f, dtype=float))
     phi_g = start.phi_g + zero
@@ -91,20 +90,16 @@ def simulate(p: Gripper, s: Schedule, start: Start, log_every: int) -> Trace:
     rec = np.empty((len(samples), len(TRACE_FIELDS), *zero.shape))
     j = 0
     for k in range(s.ticks):
-        phi_f = (phi_1 - kg * phi_g) / n
-        omega_f = (omega_1 - kg * omega_g) / n
-        d = lf * phi_f
-        f = k_c * d + c_c * lf * omega_f
-        F = 0.5 * (f + abs(f)) * (d > 0)
         I_1, I_2 = drive.I_1, drive.I_2
         tau_1, tau_2 = drive.step(k, omega_1, phi_g, omega_g)
+        a_1, a_g, F = accelerations(p, tau_1, tau_2, phi_1, omega_1, phi_g, omega_g)
         if k % log_every == 0:
+            phi_f, omega_f = (phi_1 - kg * phi_g) / n, (omega_1 - kg * omega_g) / n
             for i, value in enumerate((phi_1, omega_1, phi_g, omega_g, phi_f, omega_f, F, I_1, I_2, drive.I_ref_1,
                                        drive.I_ref_2, drive.U_1, drive.U_2)):
                 rec[j, i] = value
             j += 1
-        free_1 = omega_1 + (tau_1 - F * lf / n) / hold_1
-        free_g = omega_g + (g_c * tau_2 + kg * F * lf / n) / hold_g
+        free_1, free_g = omega_1 + h * a_1, omega_g + h * a_g
         omega_1 = (free_1 - _clip(free_1 * hold_1, tau_c1) / hold_1) / visc_1
         omega_g = (free_g - _clip(free_g * hold_g, tau_cg) / hold_g) / visc_g
         phi_1 = phi_1 + h * omega_1
