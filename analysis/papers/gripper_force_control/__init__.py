@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import re
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -26,7 +25,6 @@ SURFACE_WINDOW = 0.2    # s after the backward rotation: Fig. 9's error window (
 SETTLED = 0.01          # a rotation is done when the gripper stays within 1 % of the move from its target
 STEADY_BELOW = 0.5      # N, "in most of the cases it was below 0.5 N" (Fig. 7b)
 SAG_CASES = ("ideal", "friction", "no-feedforward")
-TARGETS = Path(__file__).with_name("targets.csv")
 
 
 # -- reading a run ------------------------------------------------------------------------------------
