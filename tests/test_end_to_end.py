@@ -26,6 +26,7 @@ def test_pipeline_to_report(data_dir):
     assert list(targets.columns) == ["slug", "target_id", "quantity", "where", "paper_value", "pipeline_value",
                                      "unit", "mode", "tolerance", "status"]
     assert set(targets["status"]) <= {"match", "close", "miss", "not-reproducible"}
+    targets = targets[targets["slug"] == "ur5-ik-fsm"]   # other papers' targets have no runs here
     status = targets.set_index("target_id")["status"]
     tables = status[status.index.str.match(r"T[346]\.")]
     assert len(tables) >= 60 + 60 + 10 and (tables == "match").all()

@@ -1,0 +1,213 @@
+"""Simulate stage of `gripper-force-control`: Fig. 8 (force sag in three cases, on both plants), Fig. 9 (one
+point of the max-force-error surface per run: a Hydra sweep over ω × ε), the pick-and-place cycle (Tables
+3 and 5, the tomato timings), a Monte-Carlo stand-in for Fig. 7, and Tables 2-5 with the model's constants.
+
+Every run logs the measured grasp force on `/wrench` and the commanded one (F_set) on `/wrench/commanded`,
+both Wrench records named `grasp` with the force along the pad normal in `force_x`; the force error is
+their difference, computed by the analysis (analysis.core.errors.force_error_stats).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from omegaconf import DictConfig, OmegaConf
+
+from pipeline.core import schemas
+from pipeline.core.experiment import Case
+from pipeline.core.runlog import RunWriter, SimulationFailed
+from pipeline.papers.gripper_force_control import lumped
+from pipeline.papers.gripper_force_control.drive import Schedule, move_duration, schedule
+from pipeline.papers.gripper_force_control.lumped import Start, Trace, static_grasp
+from pipeline.papers.gripper_force_control.model import Gripper, gripper
+from pipeline.papers.gripper_force_control.mujoco_plant import FRAMES, MujocoGripper
+
+JOINTS = ["m1", "m2", "gripper", "finger"]
+PLANTS = ("mujoco", "lumped")
+
+TableRow = schemas.define(
+    "GripperTableRow", "One row of a comparison table of the gripper paper (datasheet values as printed).",
+    table="string", gripper="string", name="string[]", value="double[]",
+)
+GraspSample = schemas.define(
+    "GripperGraspSample", "The random draws of Monte-Carlo grasps: approach gap (m) and M1 Coulomb friction (N m).",
+    name="string[]", force_set="double[]", gap="double[]", m1_coulomb="double[]",
+)
+
+
+# -- running a case on a plant ------------------------------------------------------------------------
+
+
+def run_plant(log: RunWriter, cfg: DictConfig, p: Gripper, s: Schedule, start: Start, plant: str,
+              open_stop: float | None = None) -> None:
+    """Simulate one run on `plant` and log it (and, for MuJoCo, the generated model and the body poses).
+    `open_stop`: MuJoCo's finger stops there when opening (the lumped plant has no stops)."""
+    log_every = max(1, round(cfg.log_dt / p.dt))
+    if plant == "mujoco":
+        sim = MujocoGripper(p, cfg.system.contact, open_stop)
+        log.attach("model.xml", sim.xml, "application/xml")
+        tf_every = max(1, round(cfg.tf_dt / p.dt))
+        trace, poses = sim.simulate(s, start, log_every, settle=cfg.mujoco.settle, tf_every=tf_every)
+        log.log_transforms(s.t[::tf_every], "world", list(FRAMES), poses)
+    elif plant == "lumped":
+        trace = lumped.simulate(p, s, start, log_every)
+    else:
+        raise ValueError(f"plant={plant!r}: one of {PLANTS}")
+    if not np.isfinite(trace["force"]).all():
+        raise SimulationFailed("grasp force not finite")
+    log_trace(log, p, s, trace, log_every)
+
+
+def log_trace(log: RunWriter, p: Gripper, s: Schedule, trace: Trace, log_every: int) -> None:
+    """The common topics of one run (a batch: one Wrench entry per grasp)."""
+    t, g = trace.t, p.gear
+    force, commanded = trace["force"], s.force[::log_every]
+    if force.ndim == 1:
+        force, commanded = force[:, None], commanded[:, None]
+        names = ["grasp"]
+    else:
+        names = [f"grasp{i:03d}" for i in range(force.shape[1])]
+    zero = np.zeros_like(force)
+    for topic, value in (("/wrench", force), ("/wrench/commanded", commanded)):
+        log.log_series(topic, t, frame_id="pad", name=names, force_x=value, force_y=zero, force_z=zero,
+                       torque_x=zero, torque_y=zero, torque_z=zero)
+    if trace["phi_g"].ndim > 1:
+        return
+    phi_g, omega_g = trace["phi_g"], trace["omega_g"]
+    position = np.column_stack([trace["phi_1"], -g.g_c * phi_g, phi_g, trace["phi_f"]])
+    velocity = np.column_stack([trace["omega_1"], -g.g_c * omega_g, omega_g, trace["omega_f"]])
+    effort = np.column_stack([p.K_t * trace["I_1"], -p.K_t * trace["I_2"], g.g_c * p.K_t * trace["I_2"],
+                              trace["force"] * p.l_f])   # motor torques; M2's at the gripper; the fingers' load
+    log.log_series("/joint_state", t, name=JOINTS, position=position, velocity=velocity, effort=effort)
+    phi_sr = s.phi_sr[::log_every]
+    log.log_series("/reference", t, name=["gripper"], position=phi_sr[:, None],
+                   velocity=s.omega_sr[::log_every, None], acceleration=s.epsilon_sr[::log_every, None])
+    log.log_series("/command", t, kind="voltage", name=["m1", "m2"],
+                   value=np.column_stack([trace["U_1"], trace["U_2"]]))
+    log.log_series("/drive/current", t, schemas.Scalars, name=["i_ref_m1", "i_m1", "i_ref_m2", "i_m2"],
+                   value=np.column_stack([trace["I_ref_1"], trace["I_1"], trace["I_ref_2"], trace["I_2"]]))
+    error = phi_sr - phi_g
+    log.log_series("/tracking_error", t, name=["gripper"], error=error[:, None], norm=np.abs(error))
+
+
+def _case_gripper(cfg: DictConfig, friction: bool, feedforward: bool = True, **system_overrides) -> Gripper:
+    system = cfg.system
+    if system_overrides:
+        system = OmegaConf.merge(system, OmegaConf.create(system_overrides))
+    return gripper(system).with_case(friction=friction, feedforward=feedforward)
+
+
+# -- X4 / Fig. 8: force sag during a 40° rotation ------------------------------------------------------
+
+
+def force_sag(cfg: DictConfig) -> list[Case]:
+    sc = cfg.scenario
+
+    def simulate(log: RunWriter, p: Gripper, plant: str) -> None:
+        duration = sc.start + move_duration(sc.angle, p.omega_max, p.epsilon_max) + sc.after
+        s = schedule(p, duration, sc.force, [(sc.start, sc.angle)])
+        run_plant(log, cfg, p, s, static_grasp(p, sc.force), plant)
+
+    cases = []
+    for name, case in sc.cases.items():
+        p = _case_gripper(cfg, case.friction, case.feedforward)
+        cases += [Case(f"{name}-{plant}", lambda log, p=p, plant=plant: simulate(log, p, plant)) for plant in sc.plants]
+    for form in sc.forms:   # the printed coupling factor / eq. (9) gains, ideal case
+        p = _case_gripper(cfg, False, True, gearbox={"coupling": form.coupling},
+                          controller={"feedforward": form.feedforward})
+        cases.append(Case(f"ideal-{form.plant}-coupling_{form.coupling}-ff_{form.feedforward}",
+                          lambda log, p=p, plant=form.plant: simulate(log, p, plant)))
+    return cases
+
+
+# -- X5 / Fig. 9: one point of the max-force-error surface --------------------------------------------
+
+
+def force_error_surface(cfg: DictConfig) -> list[Case]:
+    sc = cfg.scenario
+    p = _case_gripper(cfg, sc.friction)
+
+    def simulate(log: RunWriter) -> None:
+        move = move_duration(sc.angle, sc.omega, sc.epsilon)
+        back = sc.start + move + sc.pause
+        s = schedule(p, back + move + sc.after, sc.force, [(sc.start, sc.angle), (back, -sc.angle)],
+                     omega_max=sc.omega, epsilon_max=sc.epsilon)
+        run_plant(log, cfg, p, s, static_grasp(p, sc.force), sc.plant)
+
+    return [Case("rotations", simulate)]
+
+
+# -- pick and place: closing, 45° rotation, opening (Tables 3 and 5, the tomato timings) ----------------
+
+
+def pick_and_place(cfg: DictConfig) -> list[Case]:
+    sc = cfg.scenario
+
+    def simulate(log: RunWriter, p: Gripper) -> None:
+        s = schedule(p, sc.duration, sc.force, [(sc.rotate_at, sc.angle)], opening=(sc.open_at, sc.force))
+        open_angle = -sc.stroke / p.l_f
+        run_plant(log, cfg, p, s, Start(phi_f=open_angle), sc.plant, open_stop=open_angle - sc.stop_margin)
+
+    cases = []
+    for name, case in sc.cases.items():
+        p = replace(_case_gripper(cfg, sc.friction), speed_limit=case.speed_limit)
+        cases.append(Case(name, lambda log, p=p: simulate(log, p)))
+    return cases
+
+
+# -- Fig. 7 stand-in: Monte-Carlo steady-state errors ---------------------------------------------------
+
+
+def steady_state(cfg: DictConfig) -> list[Case]:
+    sc = cfg.scenario
+
+    def simulate(log: RunWriter) -> None:
+        rng = np.random.default_rng(cfg.seed)
+        forces = np.repeat(np.asarray(sc.forces, dtype=float), sc.grasps)
+        gap = rng.uniform(*sc.gap, forces.size)
+        base = _case_gripper(cfg, True)
+        coulomb = base.tau_c1 * rng.uniform(*sc.friction_scale, forces.size)
+        p = replace(base, tau_c1=coulomb)
+        s = schedule(p, sc.duration, forces)
+        names = [f"grasp{i:03d}" for i in range(forces.size)]
+        log.log("/montecarlo", 0.0, GraspSample, name=names, force_set=forces.tolist(), gap=gap.tolist(),
+                m1_coulomb=coulomb.tolist())
+        log_every = max(1, round(cfg.log_dt / p.dt))
+        trace = lumped.simulate(p, s, Start(phi_f=-gap / p.l_f), log_every)
+        log_trace(log, p, s, trace, log_every)
+
+    return [Case("grasps", simulate)]
+
+
+# -- Tables 2-5 as data, and the model's constants -------------------------------------------------------
+
+
+def tables(cfg: DictConfig) -> list[Case]:
+    sc = cfg.scenario
+
+    def simulate(log: RunWriter) -> None:
+        t = 0.0
+        for table, rows in sc.tables.items():
+            columns = list(rows.columns)
+            for gripper_name, values in rows.rows.items():
+                log.log("/tables", t, TableRow, table=table, gripper=gripper_name, name=columns,
+                        value=[float(v) for v in values])
+                t += 1e-3   # one row per millisecond: a table is a sequence of records, not a trajectory
+        p = gripper(cfg.system)
+        printed_ff = gripper(OmegaConf.merge(cfg.system, {"controller": {"feedforward": "printed"}}))
+        g = p.gear
+        constants = {
+            "l_a": g.l_a, "g_c": g.g_c, "h_g": g.h_g, "g_ps": g.g_ps, "g_pf": g.g_pf, "g_f": g.g_f, "k_g": g.k_g,
+            "force_per_amp": p.force_per_amp, "K_eps": p.K_eps, "K_omega": p.K_omega,
+            "K_eps_printed": printed_ff.K_eps, "K_omega_printed": printed_ff.K_omega,
+            "current_pole": p.R / p.L, "current_zero": 1 / p.T_c1, "current_bandwidth": p.K_c1 / p.L,
+            "velocity_crossover": p.K_v * p.K_t * g.g_c / (p.J_g + p.J_1 * g.k_g ** 2),
+            "position_bandwidth": p.K_p,
+            "move_40deg": move_duration(np.deg2rad(40), p.omega_max, p.epsilon_max),
+            "move_45deg": move_duration(np.deg2rad(45), p.omega_max, p.epsilon_max),
+            "voltage_limited_finger_speed": p.l_f * (p.U_max - p.R * p.lookup(sc.tomato_force)) / p.K_e / g.g_f,
+        }
+        log.log("/model", 0.0, schemas.Scalars, name=list(constants), value=list(constants.values()))
+
+    return [Case("paper-data", simulate)]
