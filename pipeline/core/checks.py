@@ -1,7 +1,6 @@
 """Bad input is refused before anything runs, with one line that names the key and what is allowed.
 
-`preflight(argv)` composes the config exactly as Hydra will (every combination of a sweep), then checks
-it: unknown experiment or key, a value whose type differs from its default, NaN/inf, and out-of-range
+`preflight(argv)` composes the config exactly as Hydra will (each swept value once), then checks it: unknown experiment or key, a value whose type differs from its default, NaN/inf, and out-of-range
 physical parameters (`POSITIVE_NAMES` everywhere, plus the paper's own `LIMITS`).
 """
 
@@ -9,7 +8,6 @@ from __future__ import annotations
 
 import difflib
 import importlib.util
-import itertools
 import math
 from collections.abc import Iterator
 from typing import Any
@@ -69,20 +67,30 @@ def check_config(cfg: DictConfig, defaults: DictConfig, limits: dict[str, Range 
             raise BadInput(f"{key}={value:g} is out of range: must be {allowed}")
 
 
-def _expand(overrides: list[str]) -> list[list[str]]:
-    """Every combination of a sweep, as plain override lists."""
+def _variants(overrides: list[str]) -> list[tuple[str | None, list[str]]]:
+    """(experiment, overrides) to compose and check. Every check is on one value at a time, so a sweep
+    needs each swept value once (beside the fixed overrides), not every combination: 1 + Σk, not Πk."""
     parsed = OverridesParser.create().parse_overrides(overrides)
-    choices = []
+    fixed, swept = [], {}
     for o in parsed:
         if o.is_sweep_override():
             key = o.get_key_element()
-            choices.append([f"{key}={v}" for v in o.sweep_string_iterator()])
+            swept[key] = [f"{key}={v}" for v in o.sweep_string_iterator()]
         else:
-            choices.append([o.input_line])
-    combos = [list(c) for c in itertools.islice(itertools.product(*choices), SWEEP_LIMIT + 1)]
-    if len(combos) > SWEEP_LIMIT:
-        raise BadInput(f"the sweep has more than {SWEEP_LIMIT} runs; split it")
-    return combos
+            fixed.append(o.input_line)
+    runs = 1
+    for values in swept.values():
+        runs *= len(values)
+    if runs > SWEEP_LIMIT:
+        raise BadInput(f"the sweep has {runs} runs, more than {SWEEP_LIMIT}; split it")
+    chosen = [o.split("=", 1)[1] for o in fixed if o.startswith("experiment=")]
+    experiments = [v.split("=", 1)[1] for v in swept.pop("experiment", [])] or chosen or [None]
+    base = [o for o in fixed if not o.startswith("experiment=")]
+    variants = []
+    for experiment in experiments:
+        variants.append((experiment, base))
+        variants += [(experiment, [*base, value]) for values in swept.values() for value in values]
+    return variants
 
 
 def _one_line(err: Exception, overrides: list[str], valid_keys: list[str]) -> str:
@@ -113,35 +121,35 @@ def preflight(argv: list[str]) -> None:
         return
     overrides = [a for a in argv if not a.startswith("-")]
     try:
-        combos = _expand(overrides)
+        variants = _variants(overrides)
     except BadInput:
         raise
     except Exception as err:  # the override syntax itself
         raise BadInput(f"cannot parse the overrides: {str(err).splitlines()[0]}") from None
 
     known = available_experiments()
-    for combo in combos:
-        experiment = next((o.split("=", 1)[1] for o in combo if o.startswith("experiment=")), None)
+    checked_defaults: dict[str, tuple[DictConfig, list[str], dict]] = {}
+    for experiment, extra in variants:
         if experiment is None:
             raise BadInput("choose an experiment: experiment=<slug>/<name>, one of " + ", ".join(known))
         if experiment not in known:
             hint = difflib.get_close_matches(experiment, known, n=1)
             raise BadInput(f"unknown experiment '{experiment}'"
                            + (f" (did you mean '{hint[0]}'?)" if hint else f"; one of {', '.join(known)}"))
-        if any(o.replace(" ", "") in ("hydra/launcher=ray",) for o in combo) and \
+        if any(o.replace(" ", "") == "hydra/launcher=ray" for o in extra) and \
                 importlib.util.find_spec("hydra_plugins.hydra_ray_launcher") is None:
             raise BadInput("hydra/launcher=ray needs the Ray launcher: pip install -e '.[ray]'")
-        for o in combo:
+        for o in extra:
             if o.startswith("+") and not o.startswith("+hydra"):
                 raise BadInput(f"adding keys is not allowed ('{o}'): every parameter has a default in conf/")
-
-        defaults = compose_config([f"experiment={experiment}"])
-        valid_keys = [k for k, _ in _leaves(defaults)]
-        job_overrides = [o for o in combo if not o.lstrip("+~").startswith("hydra")]
+        if experiment not in checked_defaults:
+            defaults = compose_config([f"experiment={experiment}"])
+            checked_defaults[experiment] = (defaults, [k for k, _ in _leaves(defaults)], resolve(experiment)[3])
+        defaults, valid_keys, limits = checked_defaults[experiment]
+        job_overrides = [f"experiment={experiment}", *(o for o in extra if not o.lstrip("+~").startswith("hydra"))]
         try:
             cfg = compose_config(job_overrides)
         except Exception as err:
             raise BadInput(_one_line(err, job_overrides, valid_keys)) from None
-        _, _, _, limits = resolve(experiment)
         check_config(cfg, defaults, limits)
     GlobalHydra.instance().clear()
