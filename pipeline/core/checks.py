@@ -1,7 +1,8 @@
 """Bad input is refused before anything runs, with one line that names the key and what is allowed.
 
-`preflight(argv)` composes the config exactly as Hydra will (each swept value once), then checks it: unknown experiment or key, a value whose type differs from its default, NaN/inf, and out-of-range
-physical parameters (`POSITIVE_NAMES` everywhere, plus the paper's own `LIMITS`).
+`preflight(argv)` composes the config exactly as Hydra will (each swept value once), then checks it:
+unknown experiment or key, a value whose type differs from its default, NaN/inf, and out-of-range physical
+parameters (`POSITIVE_NAMES` everywhere, plus the paper's own `LIMITS`).
 """
 
 from __future__ import annotations
