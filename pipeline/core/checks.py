@@ -117,6 +117,7 @@ def preflight(argv: list[str]) -> None:
         raise BadInput(f"cannot parse the overrides: {str(err).splitlines()[0]}") from None
 
     known = available_experiments()
+    reference: dict[str, tuple[DictConfig, list[str], dict[str, Range]]] = {}  # per experiment, not per run
     for combo in combos:
         experiment = next((o.split("=", 1)[1] for o in combo if o.startswith("experiment=")), None)
         if experiment is None:
@@ -132,14 +133,15 @@ def preflight(argv: list[str]) -> None:
             if o.startswith("+") and not o.startswith("+hydra"):
                 raise BadInput(f"adding keys is not allowed ('{o}'): every parameter has a default in conf/")
 
-        defaults = compose_config([f"experiment={experiment}"])
-        valid_keys = [k for k, _ in _leaves(defaults)]
+        if experiment not in reference:
+            defaults = compose_config([f"experiment={experiment}"])
+            reference[experiment] = (defaults, [k for k, _ in _leaves(defaults)], resolve(experiment)[3])
+        defaults, valid_keys, limits = reference[experiment]
         job_overrides = [o for o in combo if not o.lstrip("+~").startswith("hydra")]
         try:
             cfg = compose_config(job_overrides)
         except Exception as err:
             raise BadInput(_one_line(err, job_overrides, valid_keys)) from None
-        _, _, _, limits = resolve(experiment)
         check_config(cfg, defaults, limits)
     GlobalHydra.instance().clear()
 
