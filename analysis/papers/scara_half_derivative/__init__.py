@@ -276,6 +276,17 @@ def _map_figure(k: float, grid: pd.DataFrame, level: float, points: list, figure
     points, our fitted line and eq. (20)."""
     ice = grid.pivot(index="hd_xyz", columns="d_xyz", values="ice")
     ise = grid.pivot(index="hd_xyz", columns="d_xyz", values="ise")
+    if min(ice.shape) < 2:   # a single line of the grid: curves instead of surfaces
+        fig, axes = plt.subplots(1, 2, figsize=(10, 3.4))
+        for ax, table, label in zip(axes, (ice, ise), ("ICE [N²m²s]", "ISE [m²s]"), strict=True):
+            for hd, row in table.iterrows():
+                ax.plot(row.index, row.to_numpy(), "o-", label=f"hd_xyz = {hd:g}")
+            ax.set_xlabel("d_xyz [Ns/m]")
+            ax.set_ylabel(label)
+        axes[0].legend()
+        fig.suptitle(f"Fig. 6 (one grid line on disk), K = {k:g} N/m")
+        figures.save(fig, f"fig6-maps-{_stiffness_id(k)}")
+        return
     D, HD = np.meshgrid(ice.columns.to_numpy(), ice.index.to_numpy())
     fig = plt.figure(figsize=(11, 8))
     kd_ise = grid[(grid["hd_xyz"] == 0) & np.isclose(grid["d_xyz"], KD_DAMPING)]["ise"]
