@@ -28,6 +28,8 @@ LEVEL_TOLERANCE = 1e-9       # relative: grid values this close count as equal
 TABLE2 = ["e.x.max", "e.y.max", "e.z.max", "e.x.mean", "e.y.mean", "e.z.mean", "tau1.max", "tau2.max",
           "tau3.max", "tau4.max", "ise"]
 CONTROLLER_COLORS = {"kd": "C0", "kdhd": "C3", "khd": "C2"}
+FULL_PLOT_STRIDE = 5       # samples drawn in the whole-run panels (the zoom draws every sample)
+ZOOM = (0.08, 0.25)        # s before and after the peak in the zoom panels
 SETTLE_WINDOW = 0.3          # s after each move in which ringing is counted
 RINGING_FLOOR = 1e-6         # m: smaller errors are not counted as oscillation
 
@@ -186,17 +188,17 @@ def _error_figures(k: float, controllers: dict[str, tuple[Run, dict]], figures: 
     """Figs. 8-10: e_x, e_y, e_z of the three controllers, the whole run and a zoom on the largest peak."""
     for fig_number, axis in zip((8, 9, 10), AXES, strict=True):
         fig, (full, zoom) = plt.subplots(1, 2, figsize=(10, 3.4), gridspec_kw={"width_ratios": [2.2, 1]})
-        peak_t = None
-        for name in ("kd", "kdhd", "khd"):
-            if name not in controllers:
-                continue
-            err = controllers[name][0]["/tracking_error"][f"error.{axis}"] * 1e3
-            if peak_t is None:
-                peak_t = float(err.abs().idxmax())
-            for ax in (full, zoom):
-                ax.plot(err.index, err, lw=0.9, color=CONTROLLER_COLORS[name], label=name.upper())
-        if peak_t is not None:
-            zoom.set_xlim(peak_t - 0.08, peak_t + 0.25)
+        errors = {name: controllers[name][0]["/tracking_error"][f"error.{axis}"] * 1e3
+                  for name in ("kd", "kdhd", "khd") if name in controllers}
+        if not errors:
+            plt.close(fig)
+            continue
+        peak = float(next(iter(errors.values())).abs().idxmax())   # KD's largest error, or the first run's
+        for name, err in errors.items():
+            full.plot(err.index[::FULL_PLOT_STRIDE], err.to_numpy()[::FULL_PLOT_STRIDE], lw=0.9,
+                      color=CONTROLLER_COLORS[name], label=name.upper())
+            window = err.loc[peak - ZOOM[0]:peak + ZOOM[1]]
+            zoom.plot(window.index, window, lw=1.1, color=CONTROLLER_COLORS[name])
         full.set_xlabel("time [s]")
         zoom.set_xlabel("time [s] (peak zone)")
         full.set_ylabel(f"e_{axis} [mm]")
