@@ -23,6 +23,7 @@ from pipeline.papers.scara_half_derivative.arm import Arm
 
 AXES = ("x", "y", "z")
 JOINT_TORQUES = [f"value.theta{i}" for i in range(1, 5)]
+NOISE = 1e-9                 # SI: a reference value this small is round-off (τ4 ≡ 0 in the model)
 KD_DAMPING = 5000.0          # N s/m: the reference KD of every comparison (Sec. 5)
 LEVEL_TOLERANCE = 1e-9       # relative: grid values this close count as equal
 TABLE2 = ["e.x.max", "e.y.max", "e.z.max", "e.x.mean", "e.y.mean", "e.z.mean", "tau1.max", "tau2.max",
@@ -30,8 +31,7 @@ TABLE2 = ["e.x.max", "e.y.max", "e.z.max", "e.x.mean", "e.y.mean", "e.z.mean", "
 CONTROLLER_COLORS = {"kd": "C0", "kdhd": "C3", "khd": "C2"}
 FULL_PLOT_STRIDE = 5       # samples drawn in the whole-run panels (the zoom draws every sample)
 ZOOM = (0.08, 0.25)        # s before and after the peak in the zoom panels
-SETTLE_WINDOW = 0.3          # s after each move in which ringing is counted
-RINGING_FLOOR = 1e-6         # m: smaller errors are not counted as oscillation
+SWING = 5e-6                 # m: an error reversal this large counts as one swing of an oscillation
 
 
 def _model(run: Run) -> dict:
@@ -72,7 +72,7 @@ def tuning_metrics(run: Run) -> dict[str, tuple[float, str]]:
 def _percentages(m: MetricTable, reference: dict, variant: dict, run_id: str, params: dict, names) -> None:
     for name in names:
         base = reference[name][0]
-        if base:
+        if abs(base) > NOISE:   # τ4 is zero up to round-off: no percentage of noise
             m.add(run_id, f"pct.{name}", variant[name][0] / base - 1.0, "fraction", params)
 
 
@@ -137,23 +137,26 @@ def _setpoint_figures(ref: pd.DataFrame, joints: pd.DataFrame, figures: Figures)
 # -- Table 2, Figs. 8-10 ---------------------------------------------------------------------------------
 
 
-def _ringing(run: Run) -> int:
-    """Sign changes of e_x, e_y, e_z (larger than RINGING_FLOOR) within SETTLE_WINDOW after each move ends."""
-    motion = run.config["system"]["motion"]
-    err = run["/tracking_error"]
-    t = err.index.to_numpy()
-    step = motion["t_move"] + motion["t_stop"]
-    ends = motion["t_move"] + step * np.arange(2 * len(motion["directions"]))
-    window = np.zeros(len(t), dtype=bool)
-    for end in ends:
-        window |= (t >= end) & (t < end + SETTLE_WINDOW)
-    count = 0
-    for axis in AXES:
-        e = err[f"error.{axis}"].to_numpy()[window]
-        signs = np.sign(np.where(np.abs(e) > RINGING_FLOOR, e, 0.0))
-        signs = signs[signs != 0]
-        count += int((np.diff(signs) != 0).sum())
+def _reversals(e: np.ndarray, amplitude: float) -> int:
+    """How often the signal turns back by at least `amplitude` (a swing counter with hysteresis, blind to
+    numerical ripple)."""
+    count, extreme, direction = 0, e[0], 0
+    for value in e.tolist():
+        if direction >= 0 and value < extreme - amplitude:
+            count += direction == 1
+            direction, extreme = -1, value
+        elif direction <= 0 and value > extreme + amplitude:
+            count += direction == -1
+            direction, extreme = 1, value
+        elif (direction == 1 and value > extreme) or (direction == -1 and value < extreme):
+            extreme = value
     return count
+
+
+def _ringing(run: Run) -> int:
+    """Swings of e_x, e_y, e_z larger than SWING over the run: the oscillation that Figs. 8-10 show."""
+    err = run["/tracking_error"]
+    return sum(_reversals(err[f"error.{axis}"].to_numpy(), SWING) for axis in AXES)
 
 
 def analyze_table2(runs: list[Run], figures: Figures) -> pd.DataFrame:
@@ -428,9 +431,13 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
                          "points": _value(maps, sid, "locus.points"), "slope [s^-½]": _value(maps, sid, "locus.slope"),
                          "intercept [Ns^½/m]": _value(maps, sid, "locus.intercept"),
                          "paper (eq. 20)": "−9.44, 47,200"})
+        lonely = [r["stiffness"] for r in rows if r["points"] < 2]
         sections.append("## Equal-ICE locus fitted from the maps (Fig. 6, eq. 20)\n\nFor each hd_xyz of the grid, "
                         "the d_xyz at which ICE equals KD's (linear interpolation along d), then a least-squares "
-                        "line through these points.\n\n" + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".5g"))
+                        "line through these points.\n\n" + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".5g")
+                        + ("\n\nWith a single point (" + ", ".join(lonely) + ") the only grid point at KD's ICE is KD "
+                           "itself: ICE grows in every direction around it on the grid, so this model has no "
+                           "equal-ICE line through KD to fit." if lonely else ""))
     locus = metrics.get("locus")
     if locus is not None and not locus.empty:
         points = locus[locus["metric"].isin(["ise", "ice", "tau1.max", "tau2.max", "tau3.max"])]
