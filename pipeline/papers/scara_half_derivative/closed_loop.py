@@ -53,7 +53,7 @@ def make_plant(settings: PlantSettings, arm: Arm, q0, qd0, period: float, period
 
 
 @dataclass
-class Run:
+class ClosedLoopRun:
     """What one closed-loop run produced: per control period and per integration step."""
 
     t_control: np.ndarray     # (K,) control instants
@@ -66,7 +66,7 @@ class Run:
 
 
 def run_closed_loop(plant: Plant, controller: CartesianController, motion: Motion, duration: float,
-                    period: float) -> Run:
+                    period: float) -> ClosedLoopRun:
     periods = round(duration / period)
     t_control = np.arange(periods) * period
     x_d, xd_d, _ = motion(t_control)
@@ -87,5 +87,5 @@ def run_closed_loop(plant: Plant, controller: CartesianController, motion: Motio
             residual[k] = residual_of()
         plant.advance(tau[k])
     t, q, qd = plant.fine()
-    return Run(t_control, tau, wall * 1e-9, t, q, qd, residual)
+    return ClosedLoopRun(t_control, tau, wall * 1e-9, t, q, qd, residual)
 

@@ -12,7 +12,7 @@ from pipeline.core import schemas
 from pipeline.core.experiment import Case
 from pipeline.core.runlog import RunWriter
 from pipeline.papers.scara_half_derivative.arm import EXTERNAL, JOINTS, LINKS, Arm, fk, ik, jacobian, link_frames
-from pipeline.papers.scara_half_derivative.closed_loop import PlantSettings, Run, make_plant, run_closed_loop
+from pipeline.papers.scara_half_derivative.closed_loop import ClosedLoopRun, PlantSettings, make_plant, run_closed_loop
 from pipeline.papers.scara_half_derivative.controller import CartesianController, Gains
 from pipeline.papers.scara_half_derivative.setpoint import Motion
 
@@ -49,6 +49,11 @@ def _frames_with_end_effector(arm: Arm, q: np.ndarray, x_d: np.ndarray) -> np.nd
     return np.concatenate([frames, e_frame[:, None], target[:, None]], axis=1)
 
 
+def _plain(value):
+    """Tuples (of tuples) as lists, for YAML."""
+    return [_plain(v) for v in value] if isinstance(value, tuple | list) else value
+
+
 def _stride(log_dt: float, dt: float, what: str) -> int:
     stride = round(log_dt / dt)
     if stride < 1 or abs(stride * dt - log_dt) > 1e-9 * log_dt:
@@ -56,7 +61,7 @@ def _stride(log_dt: float, dt: float, what: str) -> int:
     return stride
 
 
-def log_closed_loop(log: RunWriter, cfg: DictConfig, arm: Arm, motion: Motion, run: Run, law: str) -> None:
+def log_closed_loop(log: RunWriter, cfg: DictConfig, arm: Arm, motion: Motion, run: ClosedLoopRun, law: str) -> None:
     """Fine-step signals every `execute.log_dt`, torques and controller times every control period, link
     frames every `execute.tf_dt`, and Exudyn's loop-closure gap."""
     ex = cfg.execute
@@ -90,11 +95,9 @@ def simulate_tuning(log: RunWriter, cfg: DictConfig, k_xyz: float, d_xyz: float,
     plant_settings = PlantSettings(kind=ex.plant, dt=ex.dt, spectral_radius=ex.spectral_radius,
                                    newton_tolerance=ex.newton_tolerance)
     periods = round(cfg.scenario.duration / control.dt)
-    log.attach("model.yaml", yaml.safe_dump({
-        "arm": {k: (list(map(list, v)) if k == "inertia" else list(v) if isinstance(v, tuple) else v)
-                for k, v in vars(arm).items()},
-        "gains": vars(g), "law": law, "plant": vars(plant_settings),
-        "control": OmegaConf.to_container(control, resolve=True)}, sort_keys=False), "application/yaml")
+    model = {"arm": {k: _plain(v) for k, v in vars(arm).items()}, "gains": vars(g), "law": law,
+             "plant": vars(plant_settings), "control": OmegaConf.to_container(control, resolve=True)}
+    log.attach("model.yaml", yaml.safe_dump(model, sort_keys=False), "application/yaml")
     plant = make_plant(plant_settings, arm, home(cfg), np.zeros(4), control.dt, periods)
     controller = CartesianController(arm, g, control.dt, control.gl_terms, control.compensate_stiffness)
     run = run_closed_loop(plant, controller, motion, cfg.scenario.duration, control.dt)
