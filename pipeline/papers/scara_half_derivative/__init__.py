@@ -1,0 +1,52 @@
+"""`scara-half-derivative`: Bruzzone, Nodehi — Application of Half-Derivative Damping to Cartesian Space
+Position Control of a SCARA-like Manipulator (Robotics 2022, 11, 152).
+
+The importable API (SI units, Table 1 plus the stated assumptions of conf/system/scara-half-derivative.yaml):
+
+    Arm.from_config(cfg.system)                  the RRFbR arm
+    fk(arm, θ) -> x,  jacobian(arm, θ) -> J       eqs. (3)-(7); ik(arm, x) -> θ
+    gravity_torque(arm, θ3)                       eq. (12);  balanced_theta3p(...) eq. (13)
+    Motion.from_config(...)(t) -> x_d, ẋ_d, ẍ_d   the 6-phase set-point of Sec. 4
+    CartesianController(arm, Gains(...), T_s, n)  KD (eq. 11) / KDHD (eq. 17), one call per period
+    gl_weights(1/2, n)                            eq. (16) (pipeline.robotics.fractional)
+    the plants: multibody.ExudynPlant (closed chain), lagrange.LagrangePlant (reduced model)
+"""
+
+from __future__ import annotations
+
+from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, PROBABILITY, Range
+from pipeline.papers.scara_half_derivative.arm import Arm, balanced_theta3p, fk, gravity_torque, ik, jacobian
+from pipeline.papers.scara_half_derivative.controller import CartesianController, Gains
+from pipeline.papers.scara_half_derivative.setpoint import Motion
+from pipeline.robotics.fractional import gl_weights
+
+__all__ = ["Arm", "CartesianController", "Gains", "Motion", "balanced_theta3p", "fk", "gl_weights",
+           "gravity_torque", "ik", "jacobian"]
+
+
+def __getattr__(name: str):
+    # The experiments pull in CasADi, Exudyn and the MCAP writer; the API above needs none of them.
+    if name == "EXPERIMENTS":
+        from pipeline.papers.scara_half_derivative import experiments
+
+        return {"setpoint": experiments.setpoint, "table2": experiments.table2, "maps": experiments.maps,
+                "locus": experiments.locus}
+    raise AttributeError(name)
+
+
+LIMITS: dict[str, Range] = {
+    **{f"system.geometry.{k}": POSITIVE for k in ("l1", "l2", "l3", "l4", "lG1", "lG3", "lG4", "h")},
+    "system.inertia": POSITIVE, "system.gravity": NON_NEGATIVE, "system.spring.k3": POSITIVE,
+    "system.spring.theta3p_deg": Range(ge=-90, le=90), "system.home_deg": Range(ge=-180, le=180),
+    "system.motion.distance": Range(gt=0, le=0.3), "system.motion.t_move": POSITIVE,
+    "system.motion.t_stop": NON_NEGATIVE, "system.motion.accel_fraction": Range(gt=0, le=0.5),
+    "system.motion.directions": Range(ge=-1, le=1),
+    "system.control.dt": POSITIVE, "system.control.gl_terms": Range(ge=1, le=10_000),
+    "system.control.k_theta": NON_NEGATIVE,
+    **{f"system.control.rotation.{law}.{k}": NON_NEGATIVE for law in ("kd", "kdhd") for k in ("d_theta", "hd_theta")},
+    "scenario.duration": Range(gt=0, le=600), "scenario.k_xyz": POSITIVE, "scenario.d_xyz": NON_NEGATIVE,
+    "scenario.hd_xyz": NON_NEGATIVE, "scenario.tf_dt": POSITIVE,
+    **{f"scenario.tunings.{c}.{k}": NON_NEGATIVE for c in ("kd", "kdhd", "khd") for k in ("d_xyz", "hd_xyz")},
+    "execute.dt": POSITIVE, "execute.log_dt": POSITIVE, "execute.tf_dt": POSITIVE,
+    "execute.spectral_radius": PROBABILITY, "execute.newton_tolerance": Range(gt=0, lt=1),
+}

@@ -1,0 +1,27 @@
+"""Point-to-point motion profiles shared by every paper (vectorized over time)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def trapezoid(t: np.ndarray, distance: float, duration: float, accel_fraction: float
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Trapezoidal velocity profile from 0 to `distance` in `duration`: constant acceleration for
+    accel_fraction·duration, constant velocity, then the mirror deceleration (piecewise-constant
+    acceleration, infinite jerk). Returns position, velocity, acceleration at `t`; before 0 the profile
+    rests at 0, after `duration` at `distance`."""
+    if not 0 < accel_fraction <= 0.5:
+        raise ValueError(f"accel_fraction={accel_fraction} must be in (0, 0.5]")
+    t = np.asarray(t, dtype=float)
+    ta = accel_fraction * duration
+    v_max = distance / (duration - ta)
+    a_max = v_max / ta
+    tc = np.clip(t, 0.0, duration)
+    rising, falling = tc < ta, tc > duration - ta
+    s = np.where(rising, 0.5 * a_max * tc ** 2,
+                 np.where(falling, distance - 0.5 * a_max * (duration - tc) ** 2, v_max * (tc - 0.5 * ta)))
+    v = np.where(rising, a_max * tc, np.where(falling, a_max * (duration - tc), v_max))
+    a = np.where(rising, a_max, np.where(falling, -a_max, 0.0))
+    moving = (t > 0) & (t < duration)
+    return s, np.where(moving, v, 0.0), np.where(moving, a, 0.0)
