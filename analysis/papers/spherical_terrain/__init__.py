@@ -372,7 +372,7 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
     sections = []
     for name, title, text in (
             ("paths", "Tracking runs, corrected equations", "Default gains (all 1, k_e = 1 m), start at the "
-             "origin with ψ0 = 0, forward Euler at 400 Hz. Steady-state errors of a few mm are the chattering "
+             "origin with ψ0 = 0, forward Euler at 200 Hz. Steady-state errors of a few mm are the chattering "
              "of the pursuit law around the target at this step (they halve with the step)."),
             ("printed", "Tracking runs, eqs. (25), (58), (60) as printed", "The same gains and start. With eq. "
              "(25) as printed the heading laws of 3R/RT turn away from the target; eq. (60) as printed is a "

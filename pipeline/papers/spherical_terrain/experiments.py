@@ -6,6 +6,8 @@ robot's run."""
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 from omegaconf import DictConfig
 from scipy.spatial.transform import Rotation
@@ -90,6 +92,18 @@ def shell_orientation(t: np.ndarray, omega: np.ndarray) -> np.ndarray:
     return Rotation.from_quat(attitude).as_matrix()
 
 
+def view_attachment(terrain: CosineTerrain, radius: float, spheres: list[str], half_extent: float = 3.0,
+                    spacing: float = 0.1) -> str:
+    """`view.json` for `python -m analysis.view`: a sphere of radius R at each named /tf frame, and the
+    terrain as a height field."""
+    axis = np.linspace(-half_extent, half_extent, round(2 * half_extent / spacing) + 1)
+    x, y = np.meshgrid(axis, axis)
+    z = np.round(terrain.height(x, y), 5).tolist()
+    return json.dumps({"shapes": {frame: {"sphere": radius} for frame in spheres},
+                       "surfaces": {"terrain": {"x": [-half_extent, half_extent], "y": [-half_extent, half_extent],
+                                                "z": z}}})
+
+
 def robot_model(m: Model, k: int) -> Model:
     """The batch model restricted to robot k."""
     gains = GainTable(**{f: getattr(m.gains, f)[k:k + 1] for f in GainTable.__dataclass_fields__})
@@ -129,6 +143,7 @@ def log_robot(log: RunWriter, m: Model, robot: str, traj: Trajectory, k: int, tf
     frames[:, 2, :3, :3] = tangent_rotation(*m.terrain.gradient(p_d[:, 0], p_d[:, 1]))
     frames[:, 2, :3, 3] = p_d
     log.log_transforms(t[every], "world", ["contact", "sphere", "target"], frames[every])
+    log.attach("view.json", view_attachment(m.terrain, m.radius, ["sphere"]), "application/json")
 
 
 def tracking(cfg: DictConfig) -> list[Case]:

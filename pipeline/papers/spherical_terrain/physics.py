@@ -28,6 +28,7 @@ from pipeline.papers.spherical_terrain.experiments import (
     model,
     robots,
     run_batch,
+    view_attachment,
 )
 from pipeline.papers.spherical_terrain.kinematics import CosineTerrain, contact_xy_velocity, normal
 from pipeline.papers.spherical_terrain.tracking import Model, controls, references, start_states
@@ -221,5 +222,7 @@ def physics_check(cfg: DictConfig) -> list[Case]:
                                                                                     kinematic_tf[:, 1]))
         frames[:, 2, :3, 3] = ball["p_d"][tf, k]
         log.log_transforms(ball["t"][tf], "world", ["sphere", "kinematic_model/sphere", "target"], frames)
+        log.attach("view.json", view_attachment(m.terrain, s.radius, ["sphere", "kinematic_model/sphere"]),
+                   "application/json")
 
     return [Case(f"{c}-{q}", lambda log, k=k: simulate_case(log, k)) for k, (c, q) in enumerate(pairs)]
