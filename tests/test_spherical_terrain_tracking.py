@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from omegaconf import OmegaConf
 
+from analysis.papers.spherical_terrain import convergence_time
 from pipeline.core.checks import compose_config
 from pipeline.papers.spherical_terrain import CosineTerrain, GainTable, Model, circle, controls, diamond, simulate
 from pipeline.papers.spherical_terrain.experiments import run_batch
@@ -131,6 +132,14 @@ def test_default_runs_are_converged_in_the_step():
     coarse, fine = runs[0.005], runs[0.0025]
     assert np.abs(coarse - fine).max() < 0.01
     assert len(pairs) == 3
+
+
+def test_convergence_time_is_the_last_entry_into_the_band():
+    t = np.linspace(0.0, 10.0, 10001)
+    assert convergence_time(t, np.exp(-t), 0.1) == pytest.approx(np.log(10.0), abs=1e-3)
+    bump = np.exp(-t) + 0.2 * (np.abs(t - 6.0) < 0.5)               # leaves the band once more at 5.5-6.5 s
+    assert convergence_time(t, bump, 0.1) == pytest.approx(6.5, abs=1e-3)
+    assert np.isnan(convergence_time(t, np.full_like(t, 0.2), 0.1))
 
 
 def test_gain_table_builds_the_four_laws():

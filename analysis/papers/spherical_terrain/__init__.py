@@ -13,8 +13,8 @@ from analysis.core.metrics import MetricTable
 from pipeline.core.runlog import Run
 from pipeline.papers.spherical_terrain.kinematics import CosineTerrain
 from pipeline.papers.spherical_terrain.paths import vertex_times
+from pipeline.papers.spherical_terrain.tracking import CLASSES
 
-CLASSES = ("3r", "2r", "rt", "rs")
 LABEL = {"3r": "3R-SR", "2r": "2R-SR", "rt": "RT-SR", "rs": "RS-SR"}
 COLOR = {"3r": "C0", "2r": "C1", "rt": "C2", "rs": "C3"}
 EPSILONS = (0.05, 0.1, 0.2)      # m, convergence thresholds (spec §7)
@@ -375,8 +375,9 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
              "origin with ψ0 = 0, forward Euler at 200 Hz. Steady-state errors of a few mm are the chattering "
              "of the pursuit law around the target at this step (they halve with the step)."),
             ("printed", "Tracking runs, eqs. (25), (58), (60) as printed", "The same gains and start. With eq. "
-             "(25) as printed the heading laws of 3R/RT turn away from the target; eq. (60) as printed is a "
-             "segment of the line y = x, traversed back and forth.")):
+             "(25) as printed the heading laws of 3R and RT turn them away from the target, and with eq. (58) as "
+             "printed the RS-SR's tilt rolls it away sideways; 2R-SR (ψ ≡ 0) is unaffected. Eq. (60) as printed "
+             "is a segment of the line y = x, traversed back and forth, so 'circle' here is that segment.")):
         frame = metrics.get(name)
         if frame is not None and not frame.empty:
             sections.append(f"## {title}\n\n{text}\n\n" + _run_table(frame).to_markdown(index=False, floatfmt=".4g"))

@@ -72,8 +72,9 @@ def run_batch(cfg: DictConfig) -> tuple[Model, list[tuple[str, str]], Trajectory
 
 
 def shell_angular_velocity(c: dict, radius: float) -> np.ndarray:
-    """World angular velocity of the shell, (..., 3): its tangential part rolls the sphere as ^L V = (u, v)
-    (ω × R n̂ = R(ω_l ĥ − ω_h l̂)), its normal part is the turning rate ψ̇ (eq. 46 for RS)."""
+    """World angular velocity of the shell from the rates of `controls`, (..., 3): its tangential part rolls
+    the sphere as ^L V = (u, v) (ω × R n̂ = R(ω_l ĥ − ω_h l̂)); its normal part is the turning rate ψ̇ (eq. 46
+    for RS), which moves the contact point in neither the paper's model nor rigid rolling."""
     h, lat, n = (np.stack(v, axis=-1) for v in (c["h"], c["l"], c["n"]))
     return ((c["u"] / radius)[..., None] * lat - (c["v"] / radius)[..., None] * h
             + np.asarray(c["turn"])[..., None] * n)

@@ -119,13 +119,6 @@ def sphere_center(p0: np.ndarray, n: np.ndarray, radius: float) -> np.ndarray:
     return p0 + radius * n
 
 
-def body_angular_velocity(h, lat, n, rate_h, rate_l, rate_n) -> np.ndarray:
-    """Shell angular velocity rate_h ĥ + rate_l l̂ + rate_n n̂ (world frame). Its tangential part rolls the
-    sphere: ω × R n̂ = R (rate_l ĥ − rate_h l̂), i.e. ^L V of eq. (33) with rate_l = θ̇, rate_h = φ̇."""
-    return (np.asarray(rate_h)[..., None] * h + np.asarray(rate_l)[..., None] * lat
-            + np.asarray(rate_n)[..., None] * n)
-
-
 def contact_xy_velocity(terrain, x, y, center_velocity: np.ndarray, radius: float) -> np.ndarray:
     """(ẋ, ẏ) of the contact point (x, y, f(x, y)) of a sphere in contact whose centre moves at
     `center_velocity` (..., 3).

@@ -3,14 +3,14 @@
 Each robot becomes a free ball (the paper's R, an assumed mass) on a MuJoCo height field sampled from
 eq. (59), with Coulomb friction. The paper's controller runs in closed loop on the ball: every control step
 it reads the ball's contact point, keeps the robot's internal angles (ψ, and φ for RS) by integrating its own
-commands as the kinematic model does, and asks for the shell angular velocity ω that eq. (31) needs; three
-torque-limited velocity actuators about the world axes (the internal drive) turn the ball. Gravity, contact
-softness, slip, inertia and the field's facets are what physics adds.
+commands as the kinematic model does, and asks for the shell angular velocity ω that eq. (31) needs;
+three torque-limited velocity actuators (the internal drive) turn the ball. Gravity, contact softness, slip,
+inertia, the drive's limits and the field's facets are what physics adds.
 
-Per control step the ball's actual contact-point displacement is compared with what the commanded ω gives in
-(a) the paper's model, eq. (31): ṗ = ω × R n̂, and (b) exact rigid rolling without slip: the centre moves at
-ω × R n̂, so ṗ_xy = (I + R ∂n̂_xy/∂(x, y))⁻¹ (ω × R n̂)_xy — the curvature term the paper drops (spec §10-A8).
-The same controller on the kinematic model (same step) is run beside it.
+At every step the ball's contact-point velocity is compared with what two models make of the ball's own
+measured ω: (a) the paper's, eq. (31): ṗ = ω × R n̂, and (b) exact rigid rolling without slip: the centre
+moves at ω × R n̂, so ṗ_xy = (I + R ∂n̂_xy/∂(x, y))⁻¹ (ω × R n̂)_xy — the curvature term the paper drops
+(spec §10-A8). The same controller on the kinematic model (same step) runs beside it.
 """
 
 from __future__ import annotations
@@ -28,6 +28,7 @@ from pipeline.papers.spherical_terrain.experiments import (
     model,
     robots,
     run_batch,
+    shell_angular_velocity,
     view_attachment,
 )
 from pipeline.papers.spherical_terrain.kinematics import CosineTerrain, contact_xy_velocity, normal
@@ -109,15 +110,6 @@ def lift(terrain: CosineTerrain, p: np.ndarray, velocity_xy: np.ndarray) -> np.n
     return np.concatenate([velocity_xy, (fx * velocity_xy[..., 0] + fy * velocity_xy[..., 1])[..., None]], axis=-1)
 
 
-def rolling_angular_velocity(c: dict, radius: float) -> np.ndarray:
-    """The tangential part of the shell's ω, (..., 3): what rolls the ball (^L V = ω × R n̂). The turning
-    rate ψ̇ is the robot's internal heading (its spin about n̂ moves the contact point in neither model),
-    so the drive is not asked to spin the shell: on a height field the spin grinds the ball's several
-    facet contacts against each other and pushes it sideways, which is MuJoCo's, not the terrain's."""
-    h, lat = (np.stack(v, axis=-1) for v in (c["h"], c["l"]))
-    return (c["u"] / radius)[..., None] * lat - (c["v"] / radius)[..., None] * h
-
-
 def closed_loop(cfg: DictConfig, m: Model, paths: list[str]) -> dict[str, np.ndarray]:
     """The controller of eqs. (55)-(58) driving MuJoCo balls, every control step (system.dt) recorded:
     ball centre, linear velocity, attitude (w, x, y, z), body angular velocity, and the commanded world ω."""
@@ -148,7 +140,7 @@ def closed_loop(cfg: DictConfig, m: Model, paths: list[str]) -> dict[str, np.nda
             qpos[:, :3], qvel[:, :3], qpos[:, 3:], qvel[:, 3:]
         state[:, :3] = contact_point(m.terrain, qpos[:, :3], radius, state[:, :3], iterations=3)
         c = controls(m, state, p_d[i], v_d[i])
-        omega = rolling_angular_velocity(c, radius)
+        omega = shell_angular_velocity(c, radius)
         out["omega_command"][i] = omega
         if i == steps:
             break

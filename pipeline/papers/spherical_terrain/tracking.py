@@ -1,5 +1,5 @@
 """Path tracking of Sec. 5 (modified pure pursuit, eqs. 53-58) for a batch of robots of mixed classes,
-integrated together by fixed-step RK4 (one NumPy pass per stage for the whole batch).
+integrated together (one NumPy pass per step for the whole batch).
 
 Each robot's control law is one row of a gain table: the four laws (55)-(58) are the same expression
 with different coefficients,
@@ -11,8 +11,7 @@ with different coefficients,
 with g = ‖e_t‖ / (k_e + ‖e_t‖), e_t = p_d − P0 (eq. 53) and ζ the signed angle from ĥ to e_t about n̂
 (eq. 54 gives an unsigned angle; the sign is assumption A2: counter-clockwise positive).
 
-State per robot: [x0, y0, z0, ψ, φ, θ] (θ is α for RS). z0 is integrated (eq. 31) rather than set to
-f(x0, y0), so |z0 − f(x0, y0)| measures the model's consistency.
+State per robot: [x0, y0, z0, ψ, φ, θ] (θ is α for RS).
 """
 
 from __future__ import annotations
@@ -26,7 +25,6 @@ from pipeline.papers.spherical_terrain.kinematics import CosineTerrain, local_co
 from pipeline.papers.spherical_terrain.paths import reference
 
 CLASSES = ("3r", "2r", "rt", "rs")
-STATE = ("x", "y", "z", "psi", "phi", "theta")
 # eq. (58) as printed: φ̇ = +k_φ ζ. With the corrected ψ of eq. (25) a tilt φ > 0 turns the robot clockwise
 # (eq. 44), so the tilt must oppose ζ: φ̇ = −k_φ ζ (erratum 3).
 TILT_SIGN = {"corrected": -1.0, "printed": 1.0}
