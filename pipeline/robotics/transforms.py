@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 
 def rotation_angle(R_a: np.ndarray, R_b: np.ndarray) -> np.ndarray:
@@ -14,6 +13,8 @@ def rotation_angle(R_a: np.ndarray, R_b: np.ndarray) -> np.ndarray:
 
 def quaternion_wxyz(R: np.ndarray) -> np.ndarray:
     """(..., 4) unit quaternions (w, x, y, z) of rotation matrices, batched."""
+    from scipy.spatial.transform import Rotation  # deferred: SciPy costs every process 0.2 s to import
+
     R = np.asarray(R, dtype=float)
     quat = Rotation.from_matrix(R.reshape(-1, 3, 3)).as_quat(scalar_first=True)
     return quat.reshape(*R.shape[:-2], 4)
