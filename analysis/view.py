@@ -5,7 +5,8 @@
 
 Rerun also opens the .mcap directly (`rerun <run>.mcap`): it draws /tf and decodes every other channel as
 queryable fields. This converter adds what reflection cannot: every numeric column as a time series on a
-`sim_time` timeline, and the /tf frames as a 3-D skeleton (frames joined in the order they are logged).
+`sim_time` timeline, the /tf frames as a 3-D skeleton (frames joined in the order they are logged), and the
+spheres and cylinders of `/markers` (Foxglove SceneUpdate) drawn in the /tf frame each entity names.
 """
 
 from __future__ import annotations
@@ -16,10 +17,13 @@ from pathlib import Path
 
 import numpy as np
 import rerun as rr
+from mcap.reader import make_reader
+from mcap_protobuf.decoder import DecoderFactory
 
 from pipeline.core.runlog import read_run
 
 TIMELINE = "sim_time"
+MARKERS = "/markers"
 
 
 def _frames(tf) -> dict[str, np.ndarray]:
@@ -34,6 +38,33 @@ def _frames(tf) -> dict[str, np.ndarray]:
     return out
 
 
+def _rgba(color) -> list[float]:
+    return [color.r, color.g, color.b, color.a]
+
+
+def _log_markers(rec: rr.RecordingStream, run_path: Path) -> None:
+    """SceneUpdate spheres and cylinders under world/<frame_id>/<entity id>: they move with that /tf frame."""
+    with open(run_path, "rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        for _schema, _channel, message, update in reader.iter_decoded_messages(topics=[MARKERS]):
+            rec.set_time(TIMELINE, duration=message.log_time / 1e9)
+            for entity in update.entities:
+                path = f"world/{entity.frame_id}/{entity.id}"
+                if entity.spheres:
+                    rec.log(f"{path}/spheres", rr.Ellipsoids3D(
+                        centers=[[s.pose.position.x, s.pose.position.y, s.pose.position.z] for s in entity.spheres],
+                        half_sizes=[[s.size.x / 2, s.size.y / 2, s.size.z / 2] for s in entity.spheres],
+                        colors=[_rgba(s.color) for s in entity.spheres]))
+                if entity.cylinders:
+                    c = entity.cylinders
+                    rec.log(f"{path}/cylinders", rr.Cylinders3D(
+                        lengths=[x.size.z for x in c], radii=[x.size.x / 2 for x in c],
+                        centers=[[x.pose.position.x, x.pose.position.y, x.pose.position.z] for x in c],
+                        quaternions=[[x.pose.orientation.x, x.pose.orientation.y, x.pose.orientation.z,
+                                      x.pose.orientation.w] for x in c],
+                        colors=[_rgba(x.color) for x in c]))
+
+
 def convert(run_path: Path, out: Path | None = None, spawn: bool = False) -> Path:
     run = read_run(run_path)
     out = out or run_path.with_suffix(".rrd")
@@ -45,6 +76,9 @@ def convert(run_path: Path, out: Path | None = None, spawn: bool = False) -> Pat
     for topic in run.topic_names:
         frame = run[topic]
         time = rr.TimeColumn(TIMELINE, duration=frame.index.to_numpy())
+        if topic == MARKERS:
+            _log_markers(rec, run_path)
+            continue
         if topic == "/tf" or topic.startswith("/tf/"):
             frames = _frames(frame)
             for child, pose in frames.items():
