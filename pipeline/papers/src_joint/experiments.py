@@ -13,7 +13,15 @@ from pipeline.core.experiment import Case
 from pipeline.core.runlog import RunWriter, SimulationFailed
 from pipeline.papers.src_joint import trolley as tr
 from pipeline.papers.src_joint.ik import Bars, Damper, DamperQP, IkGains, IkResult, solve_ik
-from pipeline.papers.src_joint.manipulator import Controller, Defects, FreeBotArm, Trace, position_mode, velocity_mode
+from pipeline.papers.src_joint.manipulator import (
+    SENSING,
+    Controller,
+    Defects,
+    FreeBotArm,
+    Trace,
+    position_mode,
+    velocity_mode,
+)
 from pipeline.papers.src_joint.model import Chain, ModelForm, qlog, quaternion_of, rotation
 from pipeline.papers.src_joint.physics import (
     ContactPhysics,
@@ -63,7 +71,8 @@ def euler_xyz(R: np.ndarray) -> np.ndarray:
 
 
 def angle_of(R: np.ndarray) -> np.ndarray:
-    return np.arccos(np.clip((np.trace(R, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0))
+    """Rotation angle (rad) of rotation matrices (..., 3, 3), accurate near 0 (unlike acos of the trace)."""
+    return Rotation.from_matrix(R.reshape(-1, 3, 3)).magnitude().reshape(R.shape[:-2])
 
 
 def poses(positions: np.ndarray, rotations: np.ndarray) -> np.ndarray:
@@ -138,12 +147,13 @@ def joint_model(cfg: DictConfig) -> list[Case]:
                 raise SimulationFailed(f"unknown plant {name!r}: mujoco | exact")
         return plants[name]
 
+    forms = {variant: model_form(cfg, **OmegaConf.to_container(sc.variants[variant])) for variant in sc.variants}
+
     def simulate(log: RunWriter, plant_name: str, variant: str) -> None:
         plant, xml = plant_run(plant_name)
         if xml:
             log.attach("model.xml", xml, "application/xml")
-        form = model_form(cfg, **OmegaConf.to_container(sc.variants[variant]))
-        model = model_beside(plant, lower, upper, form)
+        model = model_beside(plant, lower, upper, forms[variant])
         t = plant.times
         log.log_series("/reference", t, name=["x", "y"], velocity=np.tile(command, (len(t), 1)))
         log.log_series("/tangent_rate", t, schemas.Scalars, name=AXES, value=plant.rates)
@@ -273,6 +283,9 @@ def reach_poses(cfg: DictConfig) -> list[Case]:
         log.log("/target", 0.0, schemas.Scalars, name=["x", "y", "z", "qw", "qx", "qy", "qz"],
                 value=[*r_desired, *q_desired])
 
+    for name, plant in sc.plants.items():
+        if plant.sensing not in SENSING:
+            raise ValueError(f"scenario.plants.{name}.sensing={plant.sensing!r}: must be one of {SENSING}")
     cases = [(name, "nominal") for name in targets]
     cases += [(name, plant) for name in sc.hardware_targets for plant in sc.plants if plant != "nominal"]
     return [Case(f"{name}-{plant}", lambda log, t=name, p=plant: simulate(log, t, p)) for name, plant in cases]

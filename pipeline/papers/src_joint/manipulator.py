@@ -104,6 +104,10 @@ class Controller:
     min_arc: float
     dt: float
 
+    def __post_init__(self) -> None:
+        if self.azimuth not in tr.AZIMUTHS:
+            raise ValueError(f"azimuth={self.azimuth!r}: must be one of {tr.AZIMUTHS}")
+
     def radii(self, n: int) -> np.ndarray:
         return np.full(n + 1, self.radius)
 

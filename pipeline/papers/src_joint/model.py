@@ -271,8 +271,3 @@ def _normalized(q: np.ndarray) -> np.ndarray:
 def quaternion_error(q: np.ndarray, q_desired: np.ndarray) -> np.ndarray:
     """δ = η ε^d − η^d ε − ε^d × ε, eq. (47)."""
     return q[0] * q_desired[1:] - q_desired[0] * q[1:] - cross(q_desired[1:], q[1:])
-
-
-def canonical(q: np.ndarray) -> np.ndarray:
-    """q or −q (the same rotation), whichever has η ≥ 0."""
-    return np.where(q[..., :1] < 0, -q, q)
