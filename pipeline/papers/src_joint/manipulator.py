@@ -3,7 +3,8 @@ paper drives it — position mode (IK, position planning, steer then forward; Se
 (pose references through the damper QP, velocity planning, steer while forward; Sec. V-C).
 
 Sensing is ideal: the controller reads the plant's joint configuration (FreeBOT-SIM's sensors) and the
-trolleys' own encoders (φ, s). The plant may differ from the controller's model by `Defects`.
+trolleys' own encoders (φ, s); position mode can also steer by the encoders alone, as the physical FreeBOTs
+do. The plant may differ from the controller's model by `Defects`.
 """
 
 from __future__ import annotations
@@ -43,7 +44,7 @@ class Trace:
     u_forward: list = field(default_factory=list)
     u_steer: list = field(default_factory=list)
     wheels: list = field(default_factory=list)       # (n, 2) ω_r, ω_l
-    reference: list = field(default_factory=list)    # per joint: (s^r, φ^r) or w^r
+    reference: list = field(default_factory=list)    # per joint: (s^r − s, φ^r) in position mode, w^r in velocity
     qp_seconds: list = field(default_factory=list)
     model_seconds: list = field(default_factory=list)
     slack: list = field(default_factory=list)
