@@ -15,7 +15,7 @@ The importable API (SI units, quaternions scalar first [η, ε]):
 
 from __future__ import annotations
 
-from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, Range
+from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, OneOf, Range
 from pipeline.papers.src_joint.ik import Bars, Damper, DamperQP, IkGains, dls, solve_ik
 from pipeline.papers.src_joint.model import Chain, ModelForm, quaternion_error, rotation
 from pipeline.papers.src_joint.rolling import RollingChain
@@ -44,7 +44,11 @@ def __getattr__(name: str):
 
 
 RADIUS = Range(gt=0, le=1.0)   # m: spheres of a desk-size robot
-LIMITS: dict[str, Range] = {
+FORMS = OneOf(("corrected", "printed"))
+LIMITS: dict[str, Range | OneOf] = {
+    "system.model.radius_convention": FORMS, "system.model.free_mode_sign": FORMS,
+    "system.model.joint_update": OneOf(("incremental", "global")), "system.trolley.azimuth": FORMS,
+    "scenario.plants": OneOf(("mujoco", "exact")), "scenario.cases": OneOf(("avoid", "unconstrained")),
     "system.freebot.r_in": RADIUS, "system.freebot.r_out": RADIUS, "system.freebot.radius": RADIUS,
     "system.freebot.wheel_radius": RADIUS, "system.freebot.wheel_interval": RADIUS,
     "system.ik.xi": POSITIVE, "system.ik.lambda_max": NON_NEGATIVE, "system.ik.kp": POSITIVE,
