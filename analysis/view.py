@@ -5,29 +5,25 @@
 
 Rerun also opens the .mcap directly (`rerun <run>.mcap`): it draws /tf and decodes every other channel as
 queryable fields. This converter adds what reflection cannot: every numeric column as a time series on a
-`sim_time` timeline, and the /tf frames as a 3-D skeleton (frames joined in the order they are logged).
-
-A run may attach `view.json` to draw bodies the frames alone do not show:
-
-    {"shapes": {"<tf child frame>": {"sphere": radius}},                 moves with that frame
-     "surfaces": {"<name>": {"x": [x0, x1], "y": [y0, y1], "z": rows}}}   static height field z[i][j] at
-                                                                          (x0 + j·dx, y0 + i·dy) in the world
+`sim_time` timeline, the /tf frames as a 3-D skeleton (frames joined in the order they are logged), and the
+spheres and cylinders of `/markers` (Foxglove SceneUpdate) drawn in the /tf frame each entity names.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
 import numpy as np
 import rerun as rr
+from mcap.reader import make_reader
+from mcap_protobuf.decoder import DecoderFactory
 
 from pipeline.core.runlog import read_run
 
 TIMELINE = "sim_time"
-VIEW_ATTACHMENT = "view.json"
+MARKERS = "/markers"
 
 
 def _frames(tf) -> dict[str, np.ndarray]:
@@ -42,27 +38,31 @@ def _frames(tf) -> dict[str, np.ndarray]:
     return out
 
 
-def _height_field_mesh(x: list[float], y: list[float], z) -> rr.Mesh3D:
-    z = np.asarray(z, dtype=float)
-    rows, cols = z.shape
-    gx, gy = np.meshgrid(np.linspace(x[0], x[1], cols), np.linspace(y[0], y[1], rows))
-    corner = (np.arange(rows - 1)[:, None] * cols + np.arange(cols - 1)[None, :]).ravel()
-    triangles = np.concatenate([np.stack([corner, corner + 1, corner + cols], axis=1),
-                                np.stack([corner + 1, corner + cols + 1, corner + cols], axis=1)])
-    return rr.Mesh3D(vertex_positions=np.column_stack([gx.ravel(), gy.ravel(), z.ravel()]),
-                     triangle_indices=triangles, albedo_factor=[160, 160, 150, 255])
+def _rgba(color) -> list[float]:
+    return [color.r, color.g, color.b, color.a]
 
 
-def _log_view(rec: rr.RecordingStream, attachment: bytes) -> None:
-    """Shapes and surfaces of the run's `view.json` (static; shapes follow their /tf frames)."""
-    view = json.loads(attachment)
-    for frame, shape in (view.get("shapes") or {}).items():
-        if "sphere" in shape:
-            r = float(shape["sphere"])
-            rec.log(f"world/{frame}/shape", rr.Ellipsoids3D(
-                half_sizes=[[r, r, r]], fill_mode=rr.components.FillMode.MajorWireframe), static=True)
-    for name, surface in (view.get("surfaces") or {}).items():
-        rec.log(f"world/{name}", _height_field_mesh(surface["x"], surface["y"], surface["z"]), static=True)
+def _log_markers(rec: rr.RecordingStream, run_path: Path) -> None:
+    """SceneUpdate spheres and cylinders under world/<frame_id>/<entity id>: they move with that /tf frame."""
+    with open(run_path, "rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        for _schema, _channel, message, update in reader.iter_decoded_messages(topics=[MARKERS]):
+            rec.set_time(TIMELINE, duration=message.log_time / 1e9)
+            for entity in update.entities:
+                path = f"world/{entity.frame_id}/{entity.id}"
+                if entity.spheres:
+                    rec.log(f"{path}/spheres", rr.Ellipsoids3D(
+                        centers=[[s.pose.position.x, s.pose.position.y, s.pose.position.z] for s in entity.spheres],
+                        half_sizes=[[s.size.x / 2, s.size.y / 2, s.size.z / 2] for s in entity.spheres],
+                        colors=[_rgba(s.color) for s in entity.spheres]))
+                if entity.cylinders:
+                    c = entity.cylinders
+                    rec.log(f"{path}/cylinders", rr.Cylinders3D(
+                        lengths=[x.size.z for x in c], radii=[x.size.x / 2 for x in c],
+                        centers=[[x.pose.position.x, x.pose.position.y, x.pose.position.z] for x in c],
+                        quaternions=[[x.pose.orientation.x, x.pose.orientation.y, x.pose.orientation.z,
+                                      x.pose.orientation.w] for x in c],
+                        colors=[_rgba(x.color) for x in c]))
 
 
 def convert(run_path: Path, out: Path | None = None, spawn: bool = False) -> Path:
@@ -73,11 +73,12 @@ def convert(run_path: Path, out: Path | None = None, spawn: bool = False) -> Pat
         rec.spawn()
     rec.save(out)
     rec.log("run", rr.TextDocument("\n".join(f"{k}: {v}" for k, v in run.metadata.items())), static=True)
-    if VIEW_ATTACHMENT in run.attachments:
-        _log_view(rec, run.attachments[VIEW_ATTACHMENT])
     for topic in run.topic_names:
         frame = run[topic]
         time = rr.TimeColumn(TIMELINE, duration=frame.index.to_numpy())
+        if topic == MARKERS:
+            _log_markers(rec, run_path)
+            continue
         if topic == "/tf" or topic.startswith("/tf/"):
             frames = _frames(frame)
             for child, pose in frames.items():

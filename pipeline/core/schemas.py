@@ -10,10 +10,16 @@ A paper that needs a record the common schemas cannot hold declares it with `def
 
 from __future__ import annotations
 
+from foxglove_schemas_protobuf.Color_pb2 import Color
+from foxglove_schemas_protobuf.CylinderPrimitive_pb2 import CylinderPrimitive
 from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
 from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
+from foxglove_schemas_protobuf.Pose_pb2 import Pose
 from foxglove_schemas_protobuf.PosesInFrame_pb2 import PosesInFrame
 from foxglove_schemas_protobuf.Quaternion_pb2 import Quaternion
+from foxglove_schemas_protobuf.SceneEntity_pb2 import SceneEntity
+from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
+from foxglove_schemas_protobuf.SpherePrimitive_pb2 import SpherePrimitive
 from foxglove_schemas_protobuf.Vector3_pb2 import Vector3
 from google.protobuf import descriptor_pb2, descriptor_pool, message_factory, timestamp_pb2
 from google.protobuf.message import Message
@@ -96,6 +102,7 @@ TOPICS: dict[str, type[Message]] = {
     "/compute_time": ComputeTime,
     "/tf": FrameTransforms,
     "/poses": PosesInFrame,
+    "/markers": SceneUpdate,   # shapes to draw (spheres, cylinders, …) attached to /tf frames
 }
 
 
@@ -110,8 +117,8 @@ def for_topic(topic: str) -> type[Message] | None:
     return None
 
 
-__all__ = ["TOPICS", "FrameTransform", "FrameTransforms", "PosesInFrame", "Quaternion", "Vector3", "define",
-           "for_topic", "stamp"]
+__all__ = ["TOPICS", "Color", "CylinderPrimitive", "FrameTransform", "FrameTransforms", "Pose", "PosesInFrame",
+           "Quaternion", "SceneEntity", "SceneUpdate", "SpherePrimitive", "Vector3", "define", "for_topic", "stamp"]
 
 
 def stamp(t_ns: int) -> timestamp_pb2.Timestamp:

@@ -1,0 +1,347 @@
+"""Simulate stage of `src-joint`: the joint model against physics (E1), reaching poses A and B (E2), and
+reaching C between two bars (E3). Every run logs what the analysis needs to redraw Figs. 8-10, 13-14, 16-17
+and a 3-D replay (/tf frames of the spheres, /markers to draw them)."""
+
+from __future__ import annotations
+
+import numpy as np
+from omegaconf import DictConfig, OmegaConf
+from scipy.spatial.transform import Rotation
+
+from pipeline.core import schemas
+from pipeline.core.experiment import Case
+from pipeline.core.runlog import RunWriter, SimulationFailed
+from pipeline.papers.src_joint import trolley as tr
+from pipeline.papers.src_joint.ik import Bars, Damper, DamperQP, IkGains, IkResult, solve_ik
+from pipeline.papers.src_joint.manipulator import (
+    SENSING,
+    Controller,
+    Defects,
+    FreeBotArm,
+    Trace,
+    position_mode,
+    velocity_mode,
+)
+from pipeline.papers.src_joint.model import Chain, ModelForm, qlog, quaternion_of, rotation
+from pipeline.papers.src_joint.physics import (
+    ContactPhysics,
+    JointRecording,
+    contact_paths,
+    roll_exactly,
+    roll_in_mujoco,
+)
+
+AXES = ["x", "y", "z"]
+EULER = ["X", "Y", "Z"]   # intrinsic XYZ Euler angles (MATLAB rotm2eul(·, 'XYZ'), the paper's Figs. 9, 13, 14)
+
+
+# -- shared pieces ------------------------------------------------------------------------------------------
+
+
+def model_form(cfg: DictConfig, **overrides) -> ModelForm:
+    return ModelForm(**{**OmegaConf.to_container(cfg.system.model), **overrides})
+
+
+def freebot(cfg: DictConfig) -> tr.FreeBot:
+    f = cfg.system.freebot
+    return tr.FreeBot(r_in=f.r_in, r_out=f.r_out, wheel_radius=f.wheel_radius, wheel_interval=f.wheel_interval)
+
+
+def ik_gains(cfg: DictConfig) -> IkGains:
+    k = cfg.system.ik
+    return IkGains(xi=k.xi, lambda_max=k.lambda_max, kp=k.kp, ka=k.ka)
+
+
+def controller(cfg: DictConfig) -> Controller:
+    s = cfg.system
+    return Controller(bot=freebot(cfg), radius=s.freebot.radius, form=model_form(cfg),
+                      gains=tr.Gains(k_s=s.trolley.k_s, k_phi1=s.trolley.k_phi1, k_phi2=s.trolley.k_phi2),
+                      ik=ik_gains(cfg), steer_tol=s.trolley.steer_tol, azimuth=s.trolley.azimuth,
+                      min_rate=s.trolley.min_rate, min_arc=s.trolley.min_arc, dt=s.control.dt)
+
+
+def unit_quaternion(q) -> np.ndarray:
+    q = np.asarray(q, dtype=float)
+    return q / np.linalg.norm(q)
+
+
+def euler_xyz(R: np.ndarray) -> np.ndarray:
+    """Intrinsic XYZ Euler angles (rad) of rotation matrices (..., 3, 3)."""
+    return Rotation.from_matrix(R.reshape(-1, 3, 3)).as_euler("XYZ").reshape(*R.shape[:-2], 3)
+
+
+def angle_of(R: np.ndarray) -> np.ndarray:
+    """Rotation angle (rad) of rotation matrices (..., 3, 3), accurate near 0 (unlike acos of the trace)."""
+    return Rotation.from_matrix(R.reshape(-1, 3, 3)).magnitude().reshape(R.shape[:-2])
+
+
+def poses(positions: np.ndarray, rotations: np.ndarray) -> np.ndarray:
+    T = np.zeros((*positions.shape[:-1], 4, 4))
+    T[..., :3, :3], T[..., :3, 3], T[..., 3, 3] = rotations, positions, 1.0
+    return T
+
+
+def log_spheres(log: RunWriter, bodies: list[str], radii, colors: list[tuple]) -> None:
+    """One `/markers` message at t = 0: a sphere of each radius in each body's /tf frame."""
+    entities = [schemas.SceneEntity(
+        frame_id=body, id=body, frame_locked=True,
+        spheres=[schemas.SpherePrimitive(pose=schemas.Pose(orientation=schemas.Quaternion(w=1.0)),
+                                         size=schemas.Vector3(x=2 * r, y=2 * r, z=2 * r),
+                                         color=schemas.Color(r=c[0], g=c[1], b=c[2], a=c[3]))])
+        for body, r, c in zip(bodies, radii, colors, strict=True)]
+    log.write("/markers", 0, schemas.SceneUpdate(entities=entities))
+
+
+BASE_COLOR, LINK_COLOR, GHOST_COLOR = (0.55, 0.6, 0.7, 1.0), (0.9, 0.6, 0.2, 1.0), (0.2, 0.5, 0.9, 0.35)
+
+
+# -- E1: the joint model against physics (Sec. V-A, Figs. 8-10) -----------------------------------------------
+
+
+def contact_physics(cfg: DictConfig) -> ContactPhysics:
+    return ContactPhysics(**OmegaConf.to_container(cfg.physics))
+
+
+def model_beside(plant: JointRecording, lower: float, upper: float, form: ModelForm) -> dict[str, np.ndarray]:
+    """The paper's model driven by the Ω^B the plant realised: rotation R(q_i) (eq. 6), joint velocity by
+    eq. (1) and spatial velocity Φ_i w by eq. (8), at the plant's log times."""
+    chain = Chain([lower, upper], form)
+    dt = plant.times[1] - plant.times[0]
+    count = len(plant.times)
+    rotation_m, w, nu, tangent = (np.zeros((count, 3, 3)), np.zeros((count, 3)), np.zeros((count, 6)),
+                                  np.zeros((count, 3, 3)))
+    for j in range(count):
+        F = chain.tangent_frames()
+        rotation_m[j], tangent[j] = rotation(chain.joint_quaternions())[0], F[0]
+        w[j, :2] = plant.rates[j, :2] / chain.k_b[0]                    # eq. (1)
+        nu[j] = chain.free_modes(F)[0] @ w[j, :2]                       # eq. (8)
+        if j < count - 1:
+            chain.roll(plant.interval_rates[j:j + 1], dt)
+    return {"rotation": rotation_m, "joint_velocity": w, "spatial_velocity": nu, "tangent": tangent}
+
+
+def _joint_pose_frames(plant: JointRecording, model: dict, lower: float, upper: float) -> np.ndarray:
+    """(N, 4, 4, 4): B_{i-1}, B_i (plant), B_i (model) and the tangent plane P_i at the contact point."""
+    n = len(plant.times)
+    span = lower + upper
+    frames = np.zeros((n, 4, 4, 4))
+    frames[:, 0] = np.eye(4)
+    frames[:, 1] = poses(span * plant.tangent[:, :, 2], plant.rotation)
+    frames[:, 2] = poses(span * model["tangent"][:, :, 2], model["rotation"])
+    frames[:, 3] = poses(lower * plant.tangent[:, :, 2], plant.tangent)
+    return frames
+
+
+def joint_model(cfg: DictConfig) -> list[Case]:
+    sc = cfg.scenario
+    lower, upper, command = sc.lower_radius, sc.upper_radius, np.asarray(sc.command, dtype=float)
+    plants: dict[str, tuple[JointRecording, str | None]] = {}
+
+    def plant_run(name: str) -> tuple[JointRecording, str | None]:
+        if name not in plants:  # one physics run serves every model variant
+            if name == "mujoco":
+                plants[name] = roll_in_mujoco(lower, upper, command, sc.duration, sc.log_dt, contact_physics(cfg))
+            elif name == "exact":
+                plants[name] = roll_exactly(lower, upper, command, sc.duration, sc.log_dt), None
+            else:
+                raise SimulationFailed(f"unknown plant {name!r}: mujoco | exact")
+        return plants[name]
+
+    forms = {variant: model_form(cfg, **OmegaConf.to_container(sc.variants[variant])) for variant in sc.variants}
+
+    def simulate(log: RunWriter, plant_name: str, variant: str) -> None:
+        plant, xml = plant_run(plant_name)
+        if xml:
+            log.attach("model.xml", xml, "application/xml")
+        model = model_beside(plant, lower, upper, forms[variant])
+        t = plant.times
+        log.log_series("/reference", t, name=["x", "y"], velocity=np.tile(command, (len(t), 1)))
+        log.log_series("/tangent_rate", t, schemas.Scalars, name=AXES, value=plant.rates)
+        rotvec = Rotation.from_matrix(plant.rotation).as_rotvec()
+        log.log_series("/joint_state", t, name=AXES, position=rotvec, velocity=plant.joint_velocity)
+        log.log_series("/joint_state/model", t, name=AXES, position=Rotation.from_matrix(model["rotation"]).as_rotvec(),
+                       velocity=model["joint_velocity"])
+        six = ["wx", "wy", "wz", "vx", "vy", "vz"]
+        log.log_series("/spatial_velocity", t, schemas.Scalars, name=six, value=plant.spatial_velocity)
+        log.log_series("/spatial_velocity/model", t, schemas.Scalars, name=six, value=model["spatial_velocity"])
+        error = np.swapaxes(model["rotation"], -1, -2) @ plant.rotation     # R_modelᵀ R_plant (Fig. 9)
+        log.log_series("/tracking_error", t, name=EULER, error=euler_xyz(error), norm=angle_of(error))
+        dw = model["joint_velocity"] - plant.joint_velocity
+        log.log_series("/tracking_error/joint_velocity", t, name=AXES, error=dw, norm=np.linalg.norm(dw, axis=1))
+        dnu = model["spatial_velocity"] - plant.spatial_velocity
+        log.log_series("/tracking_error/spatial_velocity", t, name=six, error=dnu, norm=np.linalg.norm(dnu, axis=1))
+        on_lower, on_upper = contact_paths(lower, upper, plant.tangent, plant.rotation)
+        log.log_series("/contact_path", t, schemas.Scalars, name=["lower", "upper"],
+                       value=np.column_stack([on_lower, on_upper]))
+        if plant.torque is not None:
+            log.log_series("/command", t, kind="torque", name=AXES, value=plant.torque)
+            log.log_series("/contact", t, schemas.Scalars, value=plant.contact,
+                           name=["penetration", "normal_force", "friction_force"])
+        log.log_transforms(t, "world", ["B0", "B1", "B1_model", "P1"], _joint_pose_frames(plant, model, lower, upper))
+        log_spheres(log, ["B0", "B1", "B1_model"], [lower, upper, upper], [BASE_COLOR, LINK_COLOR, GHOST_COLOR])
+
+    return [Case(f"{plant}-{variant}", lambda log, p=plant, v=variant: simulate(log, p, v))
+            for plant in sc.plants for variant in sc.variants]
+
+
+# -- the manipulator runs (E2, E3): what both log ---------------------------------------------------------------
+
+
+def joint_names(n: int, fields) -> list[str]:
+    return [f"j{i + 1}.{f}" for i in range(n) for f in fields]
+
+
+def log_manipulator(log: RunWriter, trace: Trace, r_desired: np.ndarray, q_desired: np.ndarray,
+                    sphere_radius: float) -> dict[str, np.ndarray]:
+    """Joint, trolley and wheel states, end-effector errors and frames of one run; returns the arrays."""
+    a = trace.arrays()
+    t, frames = a["times"], a["frames"]
+    n = frames.shape[1] - 1
+    joints = quaternion_of(a["relative"])                     # q_i, η ≥ 0
+    joint_rot = qlog(joints)
+    w = np.concatenate([a["joint_velocity"], np.zeros((len(t), n, 1))], axis=-1)
+    log.log_series("/joint_state", t, name=joint_names(n, AXES), position=joint_rot.reshape(len(t), -1),
+                   velocity=w.reshape(len(t), -1))
+    log.log_series("/src_state", t, schemas.Scalars, name=joint_names(n, ["qw", "qx", "qy", "qz", "nx", "ny", "nz"]),
+                   value=np.concatenate([joints, a["tangent"][..., 2]], axis=-1).reshape(len(t), -1))
+    log.log_series("/trolley", t, schemas.Scalars, name=joint_names(n, ["heading", "arc", "u_forward", "u_steer"]),
+                   value=np.stack([a["heading"], a["arc"], a["u_forward"], a["u_steer"]], axis=-1).reshape(len(t), -1))
+    log.log_series("/command", t, kind="wheel speed", name=joint_names(n, ["right", "left"]),
+                   value=a["wheels"].reshape(len(t), -1))
+    e_p = r_desired - frames[:, -1, :3, 3]
+    log.log_series("/tracking_error", t, name=AXES, error=e_p, norm=np.linalg.norm(e_p, axis=1))
+    R_err = rotation(q_desired) @ np.swapaxes(frames[:, -1, :3, :3], -1, -2)     # R_d Rᵀ
+    log.log_series("/tracking_error/orientation", t, name=EULER, error=euler_xyz(R_err), norm=angle_of(R_err))
+    target = poses(r_desired, rotation(q_desired))
+    bodies = [f"B{i}" for i in range(n + 1)]
+    log.log_transforms(t, "world", [*bodies, "target"],
+                       np.concatenate([frames, np.broadcast_to(target, (len(t), 1, 4, 4))], axis=1))
+    log_spheres(log, bodies, [sphere_radius] * (n + 1), [BASE_COLOR] + [LINK_COLOR] * n)
+    return a
+
+
+# -- E2: reaching poses A and B (Sec. V-B, Figs. 11-14) ---------------------------------------------------------
+
+
+def random_targets(cfg: DictConfig, radii: np.ndarray, form: ModelForm) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Poses reachable by construction: FK of configurations rolled from the start, each contact normal
+    tilted by an angle in `scenario.random_tilt` towards a random azimuth."""
+    sc = cfg.scenario
+    rng = np.random.default_rng(cfg.seed)
+    lower, upper = radii[:-1], radii[1:]
+    out = {}
+    for k in range(sc.random_targets):
+        tilt = rng.uniform(*sc.random_tilt, sc.joints)
+        azimuth = rng.uniform(-np.pi, np.pi, sc.joints)
+        chain = Chain(radii, form)
+        # one straight roll of 1 s per joint: the contact normal turns at l_i/(l_i + l_{i-1}) |w|
+        chain.move((tilt * (lower + upper) / upper)[:, None] * np.stack([-np.sin(azimuth), np.cos(azimuth)], -1), 1.0)
+        pos, _ = chain.frames()
+        out[f"random{k + 1}"] = pos[-1], chain.orientation()
+    return out
+
+
+def log_ik(log: RunWriter, ik: IkResult) -> None:
+    """The IK's convergence and per-iteration compute time, on the IK's own time axis (from t = 0)."""
+    log.log_series("/ik", ik.times, schemas.Scalars, name=["position_error", "orientation_error", "sigma_min"],
+                   value=np.column_stack([np.linalg.norm(ik.position_error, axis=1),
+                                          np.linalg.norm(ik.orientation_error, axis=1), ik.sigma_min]))
+    log.log_series("/compute_time", ik.times, name=["ik_iteration"], calls=[1], seconds=ik.seconds[:, None])
+    solution = ik.chain.joint_quaternions()
+    names = [*joint_names(ik.chain.n, ["qw", "qx", "qy", "qz"]), "converged"]
+    log.log("/ik/solution", 0.0, schemas.Scalars, name=names,
+            value=[*np.where(solution[:, :1] < 0, -solution, solution).ravel(), float(ik.converged)])
+
+
+def reach_poses(cfg: DictConfig) -> list[Case]:
+    sc, s = cfg.scenario, cfg.system
+    n, c = sc.joints, controller(cfg)
+    radii = c.radii(n)
+    targets = {name: (np.asarray(t.position, dtype=float), unit_quaternion(t.quaternion))
+               for name, t in sc.targets.items()}
+    targets |= random_targets(cfg, radii, c.form)
+    solutions: dict[str, IkResult] = {}
+
+    def ik_for(name: str) -> IkResult:
+        if name not in solutions:  # one IK serves every plant variant of a target
+            k = s.ik
+            solutions[name] = solve_ik(Chain(radii, c.form), *targets[name], c.ik, k.dt, k.duration,
+                                       k.tol_position, k.tol_orientation, k.stall_time, k.stall_change)
+        return solutions[name]
+
+    def simulate(log: RunWriter, target: str, plant_name: str) -> None:
+        r_desired, q_desired = targets[target]
+        ik = ik_for(target)
+        log_ik(log, ik)
+        plant = sc.plants[plant_name]
+        defects = Defects(radius_offset=plant.radius_offset, slip=plant.slip)
+        arm = FreeBotArm(n, c.bot, s.freebot.radius, s.trolley.heading0, defects)
+        trace = position_mode(arm, c, ik.chain.tangent_frames(), sc.duration, plant.sensing)
+        a = log_manipulator(log, trace, r_desired, q_desired, s.freebot.radius + defects.radius_offset)
+        log.log_series("/reference", a["times"], name=joint_names(n, ["arc_left", "heading"]),
+                       position=a["reference"].reshape(len(a["times"]), -1))
+        log.log("/target", 0.0, schemas.Scalars, name=["x", "y", "z", "qw", "qx", "qy", "qz"],
+                value=[*r_desired, *q_desired])
+
+    for name, plant in sc.plants.items():
+        if plant.sensing not in SENSING:
+            raise ValueError(f"scenario.plants.{name}.sensing={plant.sensing!r}: must be one of {SENSING}")
+    cases = [(name, "nominal") for name in targets]
+    cases += [(name, plant) for name in sc.hardware_targets for plant in sc.plants if plant != "nominal"]
+    return [Case(f"{name}-{plant}", lambda log, t=name, p=plant: simulate(log, t, p)) for name, plant in cases]
+
+
+# -- E3: reaching C between two bars (Sec. V-C, Figs. 15-17) ----------------------------------------------------
+
+
+def bar_markers(log: RunWriter, bars: Bars, half_length: float) -> None:
+    """The bars as cylinders in `world` (Foxglove cylinders stand along their local z)."""
+    z = np.array([0.0, 0.0, 1.0])
+    turn = Rotation.align_vectors([bars.axis], [z])[0].as_quat()   # x, y, z, w: takes z onto the bar axis
+    cylinders = [schemas.CylinderPrimitive(
+        pose=schemas.Pose(position=schemas.Vector3(x=p[0], y=p[1], z=p[2]),
+                          orientation=schemas.Quaternion(x=turn[0], y=turn[1], z=turn[2], w=turn[3])),
+        size=schemas.Vector3(x=2 * bars.radius, y=2 * bars.radius, z=2 * half_length),
+        bottom_scale=1.0, top_scale=1.0, color=schemas.Color(r=0.3, g=0.3, b=0.3, a=1.0)) for p in bars.points]
+    log.write("/markers", 0, schemas.SceneUpdate(entities=[schemas.SceneEntity(frame_id="world", id="bars",
+                                                                               cylinders=cylinders)]))
+
+
+def avoid_obstacles(cfg: DictConfig) -> list[Case]:
+    from pipeline.papers.src_joint.physics import mujoco_clearance, scene_xml
+
+    sc, s = cfg.scenario, cfg.system
+    n, c = sc.joints, controller(cfg)
+    radii = c.radii(n)
+    r_desired, q_desired = np.asarray(sc.target.position, dtype=float), unit_quaternion(sc.target.quaternion)
+    axis = np.asarray(sc.bars.axis, dtype=float)
+    bars = Bars(np.asarray(sc.bars.points, dtype=float), axis / np.linalg.norm(axis), sc.bars.radius)
+    damper = Damper(**OmegaConf.to_container(sc.damper))
+    bar_names = [f"bar{k + 1}" for k in range(len(bars.points))]
+    pairs = [f"B{j + 1}.{b}" for j in range(n) for b in bar_names]
+
+    def simulate(log: RunWriter, case: str) -> None:
+        if case not in ("avoid", "unconstrained"):
+            raise SimulationFailed(f"unknown case {case!r}: avoid | unconstrained")
+        qp = DamperQP(2 * n, n * len(bars.points), damper)
+        arm = FreeBotArm(n, c.bot, s.freebot.radius, s.trolley.heading0)
+        trace = velocity_mode(arm, c, r_desired, q_desired, bars, qp, sc.duration, avoid=case == "avoid")
+        a = log_manipulator(log, trace, r_desired, q_desired, s.freebot.radius)
+        t = a["times"]
+        log.log_series("/reference", t, name=joint_names(n, ["x", "y"]), velocity=a["reference"].reshape(len(t), -1))
+        centres = a["frames"][:, 1:, :3, 3]
+        clearance, _ = bars.clearance(centres.reshape(-1, 3), np.tile(radii[1:], len(t)))
+        log.log_series("/clearance", t, schemas.Scalars, name=pairs, value=clearance.reshape(len(t), -1))
+        xml = scene_xml(radii, bars.points, bars.axis, bars.radius, sc.bars.half_length)
+        log.attach("scene.xml", xml, "application/xml")
+        log.log_series("/clearance/mujoco", t, schemas.Scalars, name=pairs,
+                       value=mujoco_clearance(xml, np.concatenate([np.zeros((len(t), 1, 3)), centres], axis=1))[:, 1:]
+                       .reshape(len(t), -1))
+        log.log_series("/compute_time", t, name=["model", "qp"], calls=[1, 1],
+                       seconds=np.column_stack([a["model_seconds"], a["qp_seconds"]]))
+        log.log_series("/qp", t, schemas.Scalars, name=["slack"], value=a["slack"][:, None])
+        log.log("/target", 0.0, schemas.Scalars, name=["x", "y", "z", "qw", "qx", "qy", "qz"],
+                value=[*r_desired, *q_desired])
+        bar_markers(log, bars, sc.bars.half_length)
+
+    return [Case(case, lambda log, x=case: simulate(log, x)) for case in sc.cases]
