@@ -43,13 +43,14 @@ def _rgba(color) -> list[float]:
 
 
 def _log_markers(rec: rr.RecordingStream, run_path: Path) -> None:
-    """SceneUpdate spheres and cylinders under world/<frame_id>/<entity id>: they move with that /tf frame."""
+    """SceneUpdate spheres, cylinders and triangle meshes under world/<frame_id>/<entity id>: they move with
+    that /tf frame."""
     with open(run_path, "rb") as f:
         reader = make_reader(f, decoder_factories=[DecoderFactory()])
         for _schema, _channel, message, update in reader.iter_decoded_messages(topics=[MARKERS]):
             rec.set_time(TIMELINE, duration=message.log_time / 1e9)
             for entity in update.entities:
-                path = f"world/{entity.frame_id}/{entity.id}"
+                path = "/".join(("world", *(p for p in (entity.frame_id, entity.id) if p != "world")))
                 if entity.spheres:
                     rec.log(f"{path}/spheres", rr.Ellipsoids3D(
                         centers=[[s.pose.position.x, s.pose.position.y, s.pose.position.z] for s in entity.spheres],
@@ -63,6 +64,11 @@ def _log_markers(rec: rr.RecordingStream, run_path: Path) -> None:
                         quaternions=[[x.pose.orientation.x, x.pose.orientation.y, x.pose.orientation.z,
                                       x.pose.orientation.w] for x in c],
                         colors=[_rgba(x.color) for x in c]))
+                for k, mesh in enumerate(entity.triangles):
+                    rec.log(f"{path}/triangles{k}", rr.Mesh3D(
+                        vertex_positions=[[p.x, p.y, p.z] for p in mesh.points],
+                        triangle_indices=np.asarray(mesh.indices, dtype=np.uint32).reshape(-1, 3),
+                        albedo_factor=_rgba(mesh.color)))
 
 
 def convert(run_path: Path, out: Path | None = None, spawn: bool = False) -> Path:

@@ -14,12 +14,14 @@ from foxglove_schemas_protobuf.Color_pb2 import Color
 from foxglove_schemas_protobuf.CylinderPrimitive_pb2 import CylinderPrimitive
 from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
 from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
+from foxglove_schemas_protobuf.Point3_pb2 import Point3
 from foxglove_schemas_protobuf.Pose_pb2 import Pose
 from foxglove_schemas_protobuf.PosesInFrame_pb2 import PosesInFrame
 from foxglove_schemas_protobuf.Quaternion_pb2 import Quaternion
 from foxglove_schemas_protobuf.SceneEntity_pb2 import SceneEntity
 from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
 from foxglove_schemas_protobuf.SpherePrimitive_pb2 import SpherePrimitive
+from foxglove_schemas_protobuf.TriangleListPrimitive_pb2 import TriangleListPrimitive
 from foxglove_schemas_protobuf.Vector3_pb2 import Vector3
 from google.protobuf import descriptor_pb2, descriptor_pool, message_factory, timestamp_pb2
 from google.protobuf.message import Message
@@ -106,8 +108,6 @@ TOPICS: dict[str, type[Message]] = {
 }
 
 
-
-
 def for_topic(topic: str) -> type[Message] | None:
     """The common schema of a topic or of its family (`/tracking_error/flange` is a `/tracking_error`)."""
     while topic:
@@ -117,8 +117,9 @@ def for_topic(topic: str) -> type[Message] | None:
     return None
 
 
-__all__ = ["TOPICS", "Color", "CylinderPrimitive", "FrameTransform", "FrameTransforms", "Pose", "PosesInFrame",
-           "Quaternion", "SceneEntity", "SceneUpdate", "SpherePrimitive", "Vector3", "define", "for_topic", "stamp"]
+__all__ = ["TOPICS", "Color", "CylinderPrimitive", "FrameTransform", "FrameTransforms", "Point3", "Pose",
+           "PosesInFrame", "Quaternion", "SceneEntity", "SceneUpdate", "SpherePrimitive", "TriangleListPrimitive",
+           "Vector3", "define", "for_topic", "stamp"]
 
 
 def stamp(t_ns: int) -> timestamp_pb2.Timestamp:

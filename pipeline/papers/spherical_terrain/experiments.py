@@ -6,13 +6,11 @@ robot's run."""
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 from omegaconf import DictConfig
 from scipy.spatial.transform import Rotation
 
-from pipeline.core import schemas
+from pipeline.core import markers, schemas
 from pipeline.core.experiment import Case
 from pipeline.core.runlog import RunWriter, SimulationFailed
 from pipeline.papers.spherical_terrain.kinematics import CosineTerrain, tangent_rotation
@@ -93,16 +91,17 @@ def shell_orientation(t: np.ndarray, omega: np.ndarray) -> np.ndarray:
     return Rotation.from_quat(attitude).as_matrix()
 
 
-def view_attachment(terrain: CosineTerrain, radius: float, spheres: list[str], half_extent: float = 3.0,
-                    spacing: float = 0.1) -> str:
-    """`view.json` for `python -m analysis.view`: a sphere of radius R at each named /tf frame, and the
-    terrain as a height field."""
+SHELL_COLOR, GHOST_COLOR = (0.9, 0.6, 0.2, 0.8), (0.2, 0.5, 0.9, 0.35)
+
+
+def log_scene(log: RunWriter, terrain: CosineTerrain, radius: float, spheres: dict[str, tuple],
+              half_extent: float = 3.0, spacing: float = 0.1) -> None:
+    """`/markers` for the 3-D replay: a sphere of radius R at each named /tf frame, and the terrain surface."""
     axis = np.linspace(-half_extent, half_extent, round(2 * half_extent / spacing) + 1)
     x, y = np.meshgrid(axis, axis)
-    z = np.round(terrain.height(x, y), 5).tolist()
-    return json.dumps({"shapes": {frame: {"sphere": radius} for frame in spheres},
-                       "surfaces": {"terrain": {"x": [-half_extent, half_extent], "y": [-half_extent, half_extent],
-                                                "z": z}}})
+    entities = [*markers.spheres(list(spheres), [radius] * len(spheres), list(spheres.values())),
+                markers.height_field("terrain", axis, axis, terrain.height(x, y))]
+    log.write("/markers", 0, schemas.SceneUpdate(entities=entities))
 
 
 def robot_model(m: Model, k: int) -> Model:
@@ -144,7 +143,7 @@ def log_robot(log: RunWriter, m: Model, robot: str, traj: Trajectory, k: int, tf
     frames[:, 2, :3, :3] = tangent_rotation(*m.terrain.gradient(p_d[:, 0], p_d[:, 1]))
     frames[:, 2, :3, 3] = p_d
     log.log_transforms(t[every], "world", ["contact", "sphere", "target"], frames[every])
-    log.attach("view.json", view_attachment(m.terrain, m.radius, ["sphere"]), "application/json")
+    log_scene(log, m.terrain, m.radius, {"sphere": SHELL_COLOR})
 
 
 def tracking(cfg: DictConfig) -> list[Case]:

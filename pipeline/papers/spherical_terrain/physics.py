@@ -23,13 +23,15 @@ from pipeline.core import schemas
 from pipeline.core.experiment import Case
 from pipeline.core.runlog import RunWriter, SimulationFailed
 from pipeline.papers.spherical_terrain.experiments import (
+    GHOST_COLOR,
+    SHELL_COLOR,
     XYZ,
     check_assumptions,
+    log_scene,
     model,
     robots,
     run_batch,
     shell_angular_velocity,
-    view_attachment,
 )
 from pipeline.papers.spherical_terrain.kinematics import CosineTerrain, contact_xy_velocity, normal
 from pipeline.papers.spherical_terrain.tracking import Model, controls, references, start_states
@@ -214,7 +216,6 @@ def physics_check(cfg: DictConfig) -> list[Case]:
                                                                                     kinematic_tf[:, 1]))
         frames[:, 2, :3, 3] = ball["p_d"][tf, k]
         log.log_transforms(ball["t"][tf], "world", ["sphere", "kinematic_model/sphere", "target"], frames)
-        log.attach("view.json", view_attachment(m.terrain, s.radius, ["sphere", "kinematic_model/sphere"]),
-                   "application/json")
+        log_scene(log, m.terrain, s.radius, {"sphere": SHELL_COLOR, "kinematic_model/sphere": GHOST_COLOR})
 
     return [Case(f"{c}-{q}", lambda log, k=k: simulate_case(log, k)) for k, (c, q) in enumerate(pairs)]

@@ -8,7 +8,7 @@ import numpy as np
 from omegaconf import DictConfig, OmegaConf
 from scipy.spatial.transform import Rotation
 
-from pipeline.core import schemas
+from pipeline.core import markers, schemas
 from pipeline.core.experiment import Case
 from pipeline.core.runlog import RunWriter, SimulationFailed
 from pipeline.papers.src_joint import trolley as tr
@@ -83,13 +83,7 @@ def poses(positions: np.ndarray, rotations: np.ndarray) -> np.ndarray:
 
 def log_spheres(log: RunWriter, bodies: list[str], radii, colors: list[tuple]) -> None:
     """One `/markers` message at t = 0: a sphere of each radius in each body's /tf frame."""
-    entities = [schemas.SceneEntity(
-        frame_id=body, id=body, frame_locked=True,
-        spheres=[schemas.SpherePrimitive(pose=schemas.Pose(orientation=schemas.Quaternion(w=1.0)),
-                                         size=schemas.Vector3(x=2 * r, y=2 * r, z=2 * r),
-                                         color=schemas.Color(r=c[0], g=c[1], b=c[2], a=c[3]))])
-        for body, r, c in zip(bodies, radii, colors, strict=True)]
-    log.write("/markers", 0, schemas.SceneUpdate(entities=entities))
+    log.write("/markers", 0, schemas.SceneUpdate(entities=markers.spheres(bodies, radii, colors)))
 
 
 BASE_COLOR, LINK_COLOR, GHOST_COLOR = (0.55, 0.6, 0.7, 1.0), (0.9, 0.6, 0.2, 1.0), (0.2, 0.5, 0.9, 0.35)
