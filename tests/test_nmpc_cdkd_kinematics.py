@@ -141,6 +141,18 @@ def test_configuration_selection_keeps_the_tool_vertical_on_fig3():
     assert T[-1, :3, 3] == pytest.approx([0.78, 0.39, -0.405], abs=1e-12)
 
 
+def test_quaternion_matches_scipy_on_all_pivots():
+    from scipy.spatial.transform import Rotation
+
+    R = Rotation.random(5000, random_state=11)
+    reference = R.as_quat(scalar_first=True)
+    reference *= np.where(reference[:, :1] < 0, -1, 1)
+    assert np.abs(kin.quaternion(R.as_matrix()) - reference).max() < 1e-14
+    for diag in ([1, -1, -1], [-1, 1, -1], [-1, -1, 1]):  # half turns: η = 0, one ε_i pivots
+        q = kin.quaternion(np.diag(diag))
+        assert np.abs(q).max() == 1 and q[0] == 0
+
+
 def test_orientation_error_is_zero_only_for_equal_orientations_and_half_the_small_angle():
     R = kin.hand_rotation(ARM, Q[:50, 3:])
     q = kin.quaternion(R)

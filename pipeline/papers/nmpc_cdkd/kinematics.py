@@ -14,7 +14,6 @@ import numpy as np
 
 from pipeline.robotics import dh as dhk
 from pipeline.robotics.dh import DH
-from pipeline.robotics.transforms import quaternion_wxyz
 
 JOINTS = [f"joint{i}" for i in range(1, 7)]
 BRANCHES = 8  # shoulder front/back × elbow ± × wrist ± (Sec. 2.1)
@@ -196,8 +195,22 @@ def skew(s: np.ndarray) -> np.ndarray:
 
 
 def quaternion(R: np.ndarray) -> np.ndarray:
-    """(..., 4) unit quaternion [η, ε] of rotation matrices."""
-    return quaternion_wxyz(R)
+    """(..., 4) unit quaternion [η, ε], η ≥ 0, of rotation matrices (Shepperd's method: the largest of
+    4η², 4ε_i² is taken from the diagonal, the rest from the off-diagonal sums; the paper cites [83])."""
+    R = np.asarray(R, dtype=float)
+    d = np.stack([np.trace(R, axis1=-2, axis2=-1), R[..., 0, 0], R[..., 1, 1], R[..., 2, 2]], axis=-1)
+    k = np.argmax(np.stack([d[..., 0], 2 * d[..., 1] - d[..., 0], 2 * d[..., 2] - d[..., 0],
+                            2 * d[..., 3] - d[..., 0]], axis=-1), axis=-1)
+    s21, s02, s10 = R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]
+    a01, a02, a12 = R[..., 0, 1] + R[..., 1, 0], R[..., 0, 2] + R[..., 2, 0], R[..., 1, 2] + R[..., 2, 1]
+    cases = np.stack([  # 4·x_k·q for the pivot k = η, ε_x, ε_y, ε_z
+        np.stack([1 + d[..., 0], s21, s02, s10], -1),
+        np.stack([s21, 1 + 2 * d[..., 1] - d[..., 0], a01, a02], -1),
+        np.stack([s02, a01, 1 + 2 * d[..., 2] - d[..., 0], a12], -1),
+        np.stack([s10, a02, a12, 1 + 2 * d[..., 3] - d[..., 0]], -1)], axis=-2)
+    q = np.take_along_axis(cases, k[..., None, None], axis=-2)[..., 0, :]
+    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    return np.where(q[..., :1] < 0, -q, q)
 
 
 def orientation_error(q_des: np.ndarray, q_cur: np.ndarray) -> np.ndarray:
