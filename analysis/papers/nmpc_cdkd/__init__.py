@@ -3,6 +3,9 @@ obstacles: clearance, swerve, detour, arrival) and Figs. 6-7 (moving obstacles).
 
 from __future__ import annotations
 
+from functools import cache
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 
@@ -10,6 +13,7 @@ from analysis.core.compute_time import compute_time_section, machine_of, timing_
 from analysis.core.errors import error_stats
 from analysis.core.figures import Figures, plt
 from analysis.core.metrics import MetricTable
+from analysis.core.targets import load_targets
 from pipeline.core.runlog import Run
 from pipeline.papers.nmpc_cdkd import kinematics as kin
 
@@ -18,23 +22,22 @@ ARRIVAL_POSITION = 1e-3            # m   (spec §7.7)
 ARRIVAL_ANGLE = np.deg2rad(0.5)    # rad
 FINAL_WINDOW = 0.5                 # s: "final error" = mean over the last 0.5 s (spec §7.2)
 CONTROL_HORIZON = 0.04             # s: 4 × 10 ms; solves longer than this delay the robot (Sec. 4.2)
-# Table 3, for the figure only (the comparison itself is targets.csv)
-PAPER_TABLE3_MS = {("decomposed", "no-obstacle", 10): (26, 1), ("decomposed", "no-obstacle", 20): (30, 2),
-                   ("decomposed", "obstacle", 10): (27, 2), ("decomposed", "obstacle", 20): (33, 2),
-                   ("decomposed", "obstacle-height", 10): (29, 2), ("decomposed", "obstacle-height", 20): (36, 6),
-                   ("full", "no-obstacle", 10): (130, 12), ("full", "no-obstacle", 20): (216, 21),
-                   ("full", "obstacle", 10): (153, 53), ("full", "obstacle", 20): (209, 9),
-                   ("full", "obstacle-height", 10): (230, 136), ("full", "obstacle-height", 20): (284, 112)}
+TARGETS = Path(__file__).with_name("targets.csv")
 CASE_LABELS = {"no-obstacle": "without obstacles", "obstacle": "with obstacle",
                "obstacle-height": "with obstacle and height constraints"}
 
 
+@cache
+def paper_table3() -> dict[tuple[str, str, int], tuple[float, float]]:
+    """(model, case, k) -> Table 3's (t̄, σ) in ms, from targets.csv."""
+    t = load_targets(TARGETS).set_index("target_id")["value"]
+    return {(model, case, k): (float(t[f"T3.{case}.N{n}.{short}.mean"]), float(t[f"T3.{case}.N{n}.{short}.std"]))
+            for model, short in (("decomposed", "dec"), ("full", "full")) for case in CASE_LABELS
+            for n, k in ((1, 10), (2, 20))}
+
+
 def _xyz(frame: pd.DataFrame, field: str) -> np.ndarray:
     return frame[[f"{field}.{a}" for a in XYZ]].to_numpy()
-
-
-def _solves(run: Run) -> pd.DataFrame:
-    return run["/nmpc/solve"]
 
 
 def _solve_metrics(solves: pd.DataFrame) -> dict[str, tuple[float, str]]:
@@ -61,7 +64,7 @@ def analyze_compute_time(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     mean, std = {}, {}
     for run in runs:
-        values = _solve_metrics(_solves(run))
+        values = _solve_metrics(run["/nmpc/solve"])
         m.add_run(run, values)
         mean[_combo(run.run_id)], std[_combo(run.run_id)] = values["solve.mean"][0], values["solve.std"][0]
     cases = sorted({c for _, c, _ in mean}, key=list(CASE_LABELS).index)
@@ -103,13 +106,13 @@ def analyze_compute_time(runs: list[Run], figures: Figures) -> pd.DataFrame:
 def _table3_figure(mean: dict, std: dict, figures: Figures) -> None:
     if not mean:
         return
-    keys = [k for k in PAPER_TABLE3_MS if k in mean]
+    keys = [k for k in paper_table3() if k in mean]
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.6))
     x = np.arange(len(keys))
     labels = [f"{'dec' if m == 'decomposed' else 'full'} {c.replace('obstacle', 'obst')} N{1 if k == 10 else 2}"
               for m, c, k in keys]
     for ax, (title, values) in zip(axes, (("pipeline", {k: (mean[k] * 1e3, std[k] * 1e3) for k in keys}),
-                                          ("paper, Table 3 (i7-8550U, MATLAB)", PAPER_TABLE3_MS)), strict=True):
+                                          ("paper, Table 3 (i7-8550U, MATLAB)", paper_table3())), strict=True):
         colors = ["C0" if k[0] == "decomposed" else "C1" for k in keys]
         ax.bar(x, [values[k][0] for k in keys], yerr=[values[k][1] for k in keys], color=colors, capsize=3)
         ax.set_xticks(x, labels, rotation=60, ha="right", fontsize=7)
@@ -154,7 +157,7 @@ def _trajectory_metrics(run: Run) -> dict[str, tuple[float, str]]:
     values["arrival"] = (arrival, "s")
     values["arrival_delay"] = (arrival - sc["t1"], "s")
     values |= timing_metrics("planning", run["/compute_time"]["seconds.planning"].dropna())
-    values |= _solve_metrics(_solves(run))
+    values |= _solve_metrics(run["/nmpc/solve"])
     return values
 
 
@@ -178,7 +181,7 @@ def _obstacle_metrics(run: Run) -> dict[str, tuple[float, str]]:
 
 
 def _components_figure(runs: list[Run], figures: Figures, name: str, title: str) -> None:
-    """Figs. 3a, 5, 7: tool position components vs time, reference dashed."""
+    """Figs. 5 and 7: tool position components vs time, reference dashed."""
     fig, axes = plt.subplots(1, len(runs), figsize=(4.2 * len(runs), 3.2), sharey=True, squeeze=False)
     for ax, run in zip(axes[0], runs, strict=True):
         ref = run["/reference/tool"]
@@ -348,11 +351,11 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
         rows, combos = [], [r for r in ct["run_id"].unique() if r != "table3"]
         for run_id in sorted(combos, key=lambda r: (list(CASE_LABELS).index(_combo(r)[1]), _combo(r)[2], r)):
             model, case, k = _combo(run_id)
-            paper = PAPER_TABLE3_MS.get((model, case, k))
+            paper = paper_table3().get((model, case, k))
             rows.append({"movement": CASE_LABELS[case], "horizon": f"N{1 if k == 10 else 2} (k = {k})", "model": model,
                          "t̄ ± σ [ms]": f"{_value(ct, run_id, 'solve.mean') * 1e3:.1f} ± "
                                        f"{_value(ct, run_id, 'solve.std') * 1e3:.1f}",
-                         "paper t̄ ± σ [ms]": f"{paper[0]} ± {paper[1]}" if paper else "",
+                         "paper t̄ ± σ [ms]": f"{paper[0]:g} ± {paper[1]:g}" if paper else "",
                          "median [ms]": _value(ct, run_id, "solve.median") * 1e3,
                          "p95 [ms]": _value(ct, run_id, "solve.p95") * 1e3,
                          "IPOPT iterations": _value(ct, run_id, "solve.iterations_mean"),
@@ -374,7 +377,7 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
         sections.append(compute_time_section(
             "Compute time per OCP step (median and p95)", merged, "all",
             [(f"{_combo(r)[0]}, {CASE_LABELS[_combo(r)[1]]}, k = {_combo(r)[2]}", f"{r}/solve",
-              "t̄ ± σ = {} ± {} ms".format(*PAPER_TABLE3_MS[_combo(r)])) for r in sorted(combos)],
+              "t̄ ± σ = {:g} ± {:g} ms".format(*paper_table3()[_combo(r)])) for r in sorted(combos)],
             machine_of(runs, "compute-time"), unit="ms",
             note="Python + CasADi + IPOPT (MUMPS), no code generation; the paper: MATLAB R2020a + CasADi + IPOPT "
                  "on an i7-8550U."))

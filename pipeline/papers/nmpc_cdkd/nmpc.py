@@ -143,18 +143,10 @@ class Nmpc:
         self._lbg, self._ubg = np.tile(lower, k), np.tile(upper, k)
         joints = np.arange(nx)[self.joint_slice]
         lbx, ubx = np.full((k + 1, nx), -np.inf), np.full((k + 1, nx), np.inf)
-        lbx[1:, joints], ubx[1:, joints] = self.joint_lower, self.joint_upper        # (10e), nodes 1..k
+        lbx[1:, joints], ubx[1:, joints] = self.arm.lower[:nu], self.arm.upper[:nu]  # (10e), nodes 1..k
         vel = self.arm.velocity[:nu]
         self._lbx = np.r_[lbx.ravel(), np.tile(-vel, k)]                              # (10a)
         self._ubx = np.r_[ubx.ravel(), np.tile(vel, k)]
-
-    @property
-    def joint_lower(self) -> np.ndarray:
-        return self.arm.lower[:self.nu]
-
-    @property
-    def joint_upper(self) -> np.ndarray:
-        return self.arm.upper[:self.nu]
 
     # -- NLP data from joint angles --------------------------------------------------------------------
     def state(self, q: np.ndarray) -> np.ndarray:

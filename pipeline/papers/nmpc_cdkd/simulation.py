@@ -167,8 +167,7 @@ def run(arm: Arm, nmpc: Nmpc, ctl: Controller, move: Move, make_plant,
         plant.step(cmd, qd_cmd[j], centres[j + 1])
         if not np.isfinite(plant.q).all():
             raise SimulationFailed(f"joint state not finite at t = {t[j + 1]:.3f} s")
-    if decomposed:
-        e_o[n] = e_o[n - 1]
+    e_o[n] = e_o[n - 1]
     plant.check(t, np.concatenate([q, qd], axis=1))
     return Trajectory(t=t, q=q, qd=qd, effort=effort, q_cmd=q_cmd, qd_cmd=qd_cmd, q_ref=q_ref_all[:n + 1],
                       qd_ref=qd_ref_all[:n + 1], orientation_error=e_o, centres=centres, tool_distance=tool_distance,
