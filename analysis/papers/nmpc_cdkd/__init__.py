@@ -177,6 +177,9 @@ def _obstacle_metrics(run: Run) -> dict[str, tuple[float, str]]:
               "wrist.band_violation_lower": (max(0.0, band[0] - actual[:, 2].min()), "m")}
     if cols("mujoco"):
         values["clearance.mujoco_min"] = (clearance[cols("mujoco")].to_numpy().min(), "m")
+    for column in cols("margin") + cols("tool"):  # per obstacle: value.margin.I_v -> clearance.margin_min.I_v
+        kind, name = column.removeprefix("value.").split(".", 1)
+        values[f"clearance.{kind}_min.{name}"] = (clearance[column].min(), "m")
     return values
 
 
