@@ -31,7 +31,8 @@ CASE_LABELS = {"no-obstacle": "without obstacles", "obstacle": "with obstacle",
 def paper_table3() -> dict[tuple[str, str, int], tuple[float, float]]:
     """(model, case, k) -> Table 3's (t̄, σ) in ms, from targets.csv."""
     t = load_targets(TARGETS).set_index("target_id")["value"]
-    return {(model, case, k): (float(t[f"T3.{case}.N{n}.{short}.mean"]), float(t[f"T3.{case}.N{n}.{short}.std"]))
+    row = "Tab3.{}.N{}.{}.{}".format
+    return {(model, case, k): (float(t[row(case, n, short, "mean")]), float(t[row(case, n, short, "std")]))
             for model, short in (("decomposed", "dec"), ("full", "full")) for case in CASE_LABELS
             for n, k in ((1, 10), (2, 20))}
 
