@@ -82,7 +82,7 @@ class Trajectory:
     solve_t: np.ndarray
     solves: list[Solution]
     selection: planning.Selection
-    planning_seconds: float
+    planning_seconds: float       # cold, once (NaN if the caller planned); the warm timing is the experiments'
 
 
 def _horizon_guess(nmpc: Nmpc, previous: Solution | None, shift: int, x_ref: np.ndarray,
@@ -103,7 +103,7 @@ def run(arm: Arm, nmpc: Nmpc, ctl: Controller, move: Move, make_plant,
     sel = selection or planning.select_configuration(arm, move.T_start, move.T_goal,
                                                      round(move.T / ctl.sample_dt) + 1, ctl.wrist_band)
     poly = planning.JointPolynomial(sel.q_start, sel.q_goal, move.t0, move.T)
-    planning_seconds = time.perf_counter() - start
+    planning_seconds = time.perf_counter() - start if selection is None else float("nan")
     dt, k, cs = ctl.dt, nmpc.s.horizon_steps, ctl.control_steps
     n = round(move.duration / dt)
     t_all = np.arange(n + k + 1) * dt                       # the horizon looks k steps past the end
