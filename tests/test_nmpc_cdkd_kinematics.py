@@ -14,6 +14,7 @@ from pipeline.papers.nmpc_cdkd import kinematics as kin
 from pipeline.papers.nmpc_cdkd import planning
 from pipeline.robotics import dh as dhk
 from pipeline.robotics import dh_casadi
+from pipeline.robotics.profiles import SEPTIC_PEAKS, septic
 
 SYSTEM = yaml.safe_load((CONF_DIR / "system/nmpc-cdkd.yaml").read_text())
 ARM = kin.Arm.from_config(SYSTEM)
@@ -122,10 +123,10 @@ def test_mujoco_model_matches_the_dh_chain():
 
 def test_septic_polynomial_closed_form():
     tau = np.linspace(0, 1, 200001)
-    s = planning.septic(tau)
-    assert s[0, 0] == 0 and s[0, -1] == 1 and planning.septic(0.5)[0] == pytest.approx(0.5)
+    s = septic(tau)
+    assert s[0, 0] == 0 and s[0, -1] == 1 and septic(0.5)[0] == pytest.approx(0.5)
     assert np.abs(s[1:, [0, -1]]).max() == 0          # (8): velocity, acceleration, jerk zero at both ends
-    assert np.abs(s[1:]).max(axis=1) == pytest.approx(planning.S_PEAKS, rel=1e-6)
+    assert np.abs(s[1:]).max(axis=1) == pytest.approx(SEPTIC_PEAKS, rel=1e-6)
     for order in (1, 2, 3):  # derivatives are derivatives
         assert np.abs(np.gradient(s[order - 1], tau)[1:-1] - s[order][1:-1]).max() < 1e-3
 

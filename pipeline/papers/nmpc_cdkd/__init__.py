@@ -14,7 +14,7 @@ The importable API (SI units, the Stäubli TX2-90 of Table 2):
 
 from __future__ import annotations
 
-from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, PROBABILITY, Range
+from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, PROBABILITY, OneOf, Range
 from pipeline.papers.nmpc_cdkd.kinematics import (
     Arm,
     hand_jacobian,
@@ -44,7 +44,14 @@ def __getattr__(name: str):
     raise AttributeError(name)
 
 
-LIMITS: dict[str, Range] = {
+LIMITS: dict[str, Range | OneOf] = {
+    "system.nmpc.integrator": OneOf(("rk4", "euler")), "system.nmpc.warm_start": OneOf(("shift", "reference")),
+    "system.nmpc.obstacle_prediction": OneOf(("constant_velocity", "frozen")),
+    "system.nmpc.on_failure": OneOf(("solver_iterate", "previous_plan")),
+    "system.nmpc.initial_state": OneOf(("command", "measured")),
+    "system.orientation.desired_from": OneOf(("command", "measured")),
+    "system.plant.kind": OneOf(("mujoco", "kinematic")), "scenario.models": OneOf(("decomposed", "full")),
+    "scenario.cases": OneOf(("no-obstacle", "obstacle", "obstacle-height", "a", "b", "A", "B", "fixed")),
     "system.dh.a": NON_NEGATIVE, "system.dh.d": Range(ge=-2, le=2), "system.dh.wrist_a": POSITIVE,
     "system.dh.wrist_d": NON_NEGATIVE, "system.dh.tool_d": NON_NEGATIVE,
     "system.joint_limits.velocity": POSITIVE, "system.joint_limits.acceleration": POSITIVE,

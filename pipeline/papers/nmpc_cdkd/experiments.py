@@ -10,7 +10,7 @@ from omegaconf import DictConfig, OmegaConf
 from pipeline.core import schemas
 from pipeline.core.experiment import Case
 from pipeline.core.runlog import RunWriter
-from pipeline.core.timing import time_calls
+from pipeline.core.timing import log_timings, time_calls
 from pipeline.papers.nmpc_cdkd import kinematics as kin
 from pipeline.papers.nmpc_cdkd import planning
 from pipeline.papers.nmpc_cdkd.kinematics import JOINTS, Arm
@@ -159,8 +159,7 @@ def _scene_case(cfg: DictConfig, model: str, obstacles: Obstacles, band: tuple[f
         plan = time_calls("planning", planning.select_configuration,
                           [(arm, move.T_start, move.T_goal, round(move.T / ctl.sample_dt) + 1, ctl.wrist_band)],
                           warmup=3, repeats=PLANNING_REPEATS)
-        log.log_series("/compute_time", np.arange(PLANNING_REPEATS) * 1e-3, name=["planning"], calls=[1],
-                       seconds=plan.seconds[:, None])
+        log_timings(log, [plan])
 
     return simulate
 

@@ -8,26 +8,13 @@ import numpy as np
 
 from pipeline.papers.nmpc_cdkd import kinematics as kin
 from pipeline.papers.nmpc_cdkd.kinematics import Arm
-
-# Peaks of |s'|, |s''|, |s'''| over τ ∈ [0, 1] for s = 35τ⁴ − 84τ⁵ + 70τ⁶ − 20τ⁷ (spec §3.3)
-S_PEAKS = (2.1875, 7.513188404399293, 52.5)
-
-
-def septic(tau: np.ndarray) -> np.ndarray:
-    """(4, ...): s and its first three τ-derivatives; (8) with zero velocity, acceleration and jerk at both ends.
-    τ outside [0, 1] holds the end value."""
-    t = np.clip(np.asarray(tau, dtype=float), 0.0, 1.0)
-    inside = (np.asarray(tau) > 0) & (np.asarray(tau) < 1)
-    s = t ** 4 * (35 - 84 * t + 70 * t ** 2 - 20 * t ** 3)
-    d1 = 140 * t ** 3 * (1 - t) ** 3
-    d2 = 420 * t ** 2 * (1 - t) ** 2 * (1 - 2 * t)
-    d3 = 840 * t * (1 - t) * (1 - 5 * t + 5 * t ** 2)
-    return np.stack([s, d1 * inside, d2 * inside, d3 * inside])
+from pipeline.robotics.profiles import SEPTIC_PEAKS, septic
 
 
 @dataclass(frozen=True)
 class JointPolynomial:
-    """γ(t) of (7): q0 at t ≤ t0, q1 at t ≥ t0 + T, the septic blend in between."""
+    """γ(t) of (7)-(8): q0 at t ≤ t0, q1 at t ≥ t0 + T, the septic blend in between (zero velocity,
+    acceleration and jerk at both ends; the paper states zero acceleration and jerk, rest is implied)."""
 
     q0: np.ndarray
     q1: np.ndarray
@@ -47,9 +34,9 @@ def transition_time(q0: np.ndarray, q1: np.ndarray, velocity: np.ndarray, accele
     """The shortest T ≥ t_min for which the polynomial uses at most `margin` of the speed, acceleration and
     jerk limits ("T must be chosen so that the dynamic joint limits are not violated", Sec. 3.1)."""
     dq = np.abs(q1 - q0)
-    return float(max(t_min, np.max(S_PEAKS[0] * dq / (margin * velocity)),
-                     np.sqrt(np.max(S_PEAKS[1] * dq) / (margin * acceleration)),
-                     np.cbrt(np.max(S_PEAKS[2] * dq) / (margin * jerk))))
+    return float(max(t_min, np.max(SEPTIC_PEAKS[0] * dq / (margin * velocity)),
+                     np.sqrt(np.max(SEPTIC_PEAKS[1] * dq) / (margin * acceleration)),
+                     np.cbrt(np.max(SEPTIC_PEAKS[2] * dq) / (margin * jerk))))
 
 
 @dataclass(frozen=True)
