@@ -16,7 +16,7 @@ from pipeline.papers.nmpc_cdkd import planning
 from pipeline.papers.nmpc_cdkd.kinematics import JOINTS, Arm
 from pipeline.papers.nmpc_cdkd.nmpc import Nmpc, OcpSettings
 from pipeline.papers.nmpc_cdkd.plant import KinematicPlant, MujocoPlant, model_xml
-from pipeline.papers.nmpc_cdkd.simulation import Controller, Move, Obstacles, Trajectory, run
+from pipeline.papers.nmpc_cdkd.simulation import Controller, Move, Obstacles, Trajectory, closed_loop, run
 
 XYZ = ["x", "y", "z"]
 PLANNING_REPEATS = 20
@@ -218,23 +218,49 @@ def random_moves(cfg: DictConfig, arm: Arm) -> list[dict]:
     return moves
 
 
+def _moves_loop(cfg: DictConfig, arm: Arm, moves: list[dict], model: str, case: str, k: int):
+    """One (model, case, horizon) over all moves, pausing after every OCP solve; returns the trajectories."""
+    sc = cfg.scenario
+    with_obstacle, with_band = case != "no-obstacle", case == "obstacle-height"
+    nmpc = nmpc_of(cfg, arm, model, k, int(with_obstacle), with_band)
+    trajectories = []
+    for m in moves:
+        obstacles = (Obstacles(m["centre"][None], np.zeros((1, 3)), np.array([sc.obstacle.radius]))
+                     if with_obstacle else Obstacles.none())
+        move = Move(m["T_start"], m["T_goal"], sc.t0, m["T"], sc.t0 + m["T"] + sc.settle, obstacles,
+                    m["band"] if with_band else None)
+        tr = yield from closed_loop(arm, nmpc, controller_of(cfg), move, plant_factory(cfg, arm, obstacles, None),
+                                    m["selection"])
+        trajectories.append((tr, obstacles))
+    return trajectories
+
+
 def compute_time(cfg: DictConfig) -> list[Case]:
+    """One run per (model, case, horizon). All of them are simulated together, on the first run's turn: the
+    closed loops advance one OCP solve each in turn (like `time_interleaved`), so a change of load on a shared
+    machine falls on every combination alike and the ratios of Table 3 stay fair."""
     sc = cfg.scenario
     arm = arm_of(cfg)
-    moves = random_moves(cfg, arm)
+    combos = [(model, case, k) for model in sc.models for case in sc.cases for k in sc.horizons]
+    results: dict[tuple, list] = {}
 
-    def simulate(log: RunWriter, model: str, case: str, k: int) -> None:
-        with_obstacle, with_band = case != "no-obstacle", case == "obstacle-height"
-        nmpc = nmpc_of(cfg, arm, model, k, int(with_obstacle), with_band)
+    def simulate_all() -> None:
+        moves = random_moves(cfg, arm)
+        active = {combo: _moves_loop(cfg, arm, moves, *combo) for combo in combos}
+        while active:
+            for combo, loop in list(active.items()):
+                try:
+                    next(loop)
+                except StopIteration as done:
+                    results[combo] = done.value
+                    del active[combo]
+
+    def simulate(log: RunWriter, combo: tuple) -> None:
+        if not results:
+            simulate_all()
         offset = 0.0
-        for m in moves:
-            obstacles = (Obstacles(m["centre"][None], np.zeros((1, 3)), np.array([sc.obstacle.radius]))
-                         if with_obstacle else Obstacles.none())
-            move = Move(m["T_start"], m["T_goal"], sc.t0, m["T"], sc.t0 + m["T"] + sc.settle, obstacles,
-                        m["band"] if with_band else None)
-            tr = run(arm, nmpc, controller_of(cfg), move, plant_factory(cfg, arm, obstacles, None), m["selection"])
-            log_trajectory(log, arm, tr, model, obstacles, ["obstacle"], offset)
+        for tr, obstacles in results[combo]:
+            log_trajectory(log, arm, tr, combo[0], obstacles, ["obstacle"], offset)
             offset += float(tr.t[-1]) + cfg.system.dt
 
-    return [Case(f"{model}-{case}-k{k}", lambda log, m=model, c=case, k=k: simulate(log, m, c, k))
-            for model in sc.models for case in sc.cases for k in sc.horizons]
+    return [Case(f"{model}-{case}-k{k}", lambda log, c=(model, case, k): simulate(log, c)) for model, case, k in combos]

@@ -6,6 +6,7 @@ controller (13) on q4..q6; the plant executes the command."""
 from __future__ import annotations
 
 import time
+from collections.abc import Generator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -99,6 +100,18 @@ def run(arm: Arm, nmpc: Nmpc, ctl: Controller, move: Move, make_plant,
         selection: planning.Selection | None = None) -> Trajectory:
     """Plan the move (Sec. 3.1) unless `selection` is given, then run it in closed loop; `make_plant(q0)`
     builds the plant at the start."""
+    loop = closed_loop(arm, nmpc, ctl, move, make_plant, selection)
+    while True:
+        try:
+            next(loop)
+        except StopIteration as done:
+            return done.value
+
+
+def closed_loop(arm: Arm, nmpc: Nmpc, ctl: Controller, move: Move, make_plant,
+                selection: planning.Selection | None = None) -> Generator[None, None, Trajectory]:
+    """`run` as a generator that pauses after every OCP solve, so several closed loops can be advanced in
+    turn (their solve times then see the same machine load) and returns the Trajectory."""
     start = time.perf_counter()
     sel = selection or planning.select_configuration(arm, move.T_start, move.T_goal,
                                                      round(move.T / ctl.sample_dt) + 1, ctl.wrist_band)
@@ -148,6 +161,7 @@ def run(arm: Arm, nmpc: Nmpc, ctl: Controller, move: Move, make_plant,
             last = sol
             if sol.success or ctl.on_failure == "solver_iterate":
                 plan, plan_start = sol, j
+            yield
         offset = j - plan_start
         u = plan.u[offset] if plan is not None and offset < k else np.zeros(nmpc.nu)
         u_applied = np.stack([u, u_applied[0]])
