@@ -373,8 +373,9 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
                        "growth N1→N2 full": _value(ct, "table3", f"growth.full.{c}")} for c in CASE_LABELS]
         sections.append(
             "## Table 3: OCP solve time per step\n\nEach NMPC runs its own closed loop (ideal kinematic plant) over "
-            "the same seeded random point-to-point moves; every solve is one sample (wall time of the IPOPT call, "
-            "warm-started). Failed solves are counted, not dropped.\n\n" + table
+            "the same seeded random point-to-point moves; the 12 loops advance one solve each in turn, so machine "
+            "load falls on all alike. Every solve is one sample (wall time of the IPOPT call, warm-started); failed "
+            "solves are counted, not dropped. More moves: `scenario.moves=10`.\n\n" + table
             + "\n\nRatios (paper: 0.13–0.20; growth dec +15/+22/+24 %, full +66/+37/+23 %):\n\n"
             + pd.DataFrame(ratio_rows).to_markdown(index=False, floatfmt=".3f"))
         merged = ct.assign(metric=ct["run_id"] + "/" + ct["metric"], run_id="all")
