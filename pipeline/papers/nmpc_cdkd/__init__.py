@@ -69,7 +69,7 @@ LIMITS: dict[str, Range | OneOf] = {
     "system.scene.obstacles.radii": POSITIVE,
     "scenario.t0": NON_NEGATIVE, "scenario.t1": POSITIVE, "scenario.settle": NON_NEGATIVE,
     "scenario.moves": Range(ge=1), "scenario.horizons": Range(ge=2, le=200),
-    "scenario.min_transition_time": POSITIVE, "scenario.wrist_radius": POSITIVE,
+    "scenario.min_transition_time": POSITIVE, "scenario.tool_lengths": NON_NEGATIVE, "scenario.wrist_radius": POSITIVE,
     "scenario.azimuth_change": Range(gt=0, le=3.1416), "scenario.obstacle.radius": POSITIVE,
     "scenario.obstacle.drop": Range(ge=0, le=1), "scenario.obstacle.offset": PROBABILITY,
     "scenario.obstacle.clearance": NON_NEGATIVE,

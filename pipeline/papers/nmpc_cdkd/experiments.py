@@ -151,6 +151,8 @@ def _scene_case(cfg: DictConfig, model: str, obstacles: Obstacles, band: tuple[f
     names = list(cfg.system.scene.obstacles.names)[:len(obstacles)]
 
     def simulate(log: RunWriter) -> None:
+        # what this case simulated (a case may change the experiment's config, e.g. the rod length)
+        log.attach("case_config.yaml", OmegaConf.to_yaml(cfg, resolve=True), "application/yaml")
         nmpc = nmpc_of(cfg, arm, model, cfg.system.nmpc.horizon_steps, len(obstacles), band is not None)
         ctl = controller_of(cfg)
         tr = run(arm, nmpc, ctl, move, plant_factory(cfg, arm, obstacles, log))
@@ -165,7 +167,18 @@ def _scene_case(cfg: DictConfig, model: str, obstacles: Obstacles, band: tuple[f
 
 
 def tracking(cfg: DictConfig) -> list[Case]:
-    return [Case(model, _scene_case(cfg, model, Obstacles.none(), None)) for model in cfg.scenario.models]
+    cases = []
+    z_e = np.diag(cfg.system.scene.tool_axes)[:, 2]
+    for d_e in cfg.scenario.tool_lengths:
+        # another rod length moves the tool points along the tool axis, so the wrist path stays the same
+        shift = -(cfg.system.dh.tool_d - d_e) * z_e
+        tool_cfg = OmegaConf.merge(cfg, {"system": {"dh": {"tool_d": d_e}},
+                                         "scenario": {"start": (np.asarray(cfg.scenario.start) + shift).tolist(),
+                                                      "goal": (np.asarray(cfg.scenario.goal) + shift).tolist()}})
+        suffix = "" if d_e == cfg.system.dh.tool_d else f"-de{d_e * 1e3:g}mm"
+        cases += [Case(model + suffix, _scene_case(tool_cfg, model, Obstacles.none(), None))
+                  for model in cfg.scenario.models]
+    return cases
 
 
 def fixed_obstacles(cfg: DictConfig) -> list[Case]:
