@@ -167,6 +167,7 @@ def _obstacle_metrics(run: Run) -> dict[str, tuple[float, str]]:
     actual = ref - _xyz(run["/tracking_error/wrist"], "error")
     cols = lambda prefix: [c for c in clearance.columns if c.startswith(f"value.{prefix}.")]  # noqa: E731
     values = {"clearance.margin_min": (clearance[cols("margin")].to_numpy().min(), "m"),
+              "clearance.command_margin_min": (clearance[cols("command_margin")].to_numpy().min(), "m"),
               "clearance.tool_min": (clearance[cols("tool")].to_numpy().min(), "m"),
               "wrist.z_rise_max": ((actual[:, 2] - ref[:, 2]).max(), "m"),
               "wrist.z_max": (actual[:, 2].max(), "m"),
@@ -347,7 +348,9 @@ TRAJECTORY_COLUMNS = [  # (metric, column, factor from SI)
     ("tool_error.max", "max ‖p̃‖ [mm]", 1e3), ("tool_error.rms", "RMS ‖p̃‖ [mm]", 1e3),
     ("tool_error.final", "final ‖p̃‖ [mm]", 1e3), ("wrist_error.max", "max wrist error [mm]", 1e3),
     ("orientation_error.max_component", "max |ẽ_i|", 1.0), ("arrival_delay", "arrival − t1 [s]", 1.0),
-    ("clearance.margin_min", "min (10f) margin [mm]", 1e3), ("clearance.tool_min", "min tool clearance [mm]", 1e3),
+    ("clearance.margin_min", "min (10f) margin [mm]", 1e3),
+    ("clearance.command_margin_min", "min (10f) margin, commanded [mm]", 1e3),
+    ("clearance.tool_min", "min tool clearance [mm]", 1e3),
     ("clearance.mujoco_min", "min MuJoCo clearance [mm]", 1e3), ("wrist.z_max", "max wrist z [mm]", 1e3),
     ("wrist.xy_deviation_max", "max wrist xy deviation [mm]", 1e3), ("solve.mean", "t̄ solve [ms]", 1e3),
     ("solve.failures", "failed solves", 1.0), ("planning.median", "planning, median [ms]", 1e3)]

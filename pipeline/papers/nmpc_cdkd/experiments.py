@@ -125,9 +125,11 @@ def log_trajectory(log: RunWriter, arm: Arm, tr: Trajectory, model: str, obstacl
     children = [f"link{i}" for i in range(1, 7)] + ["tool"]
     if len(obstacles):
         centres = tr.centres
-        margin = np.linalg.norm(wrist[:, None, :] - centres, axis=-1) - (obstacles.radii + arm.safety_radius)
-        columns = [margin, _segment_clearance(wrist, tip, centres, obstacles.radii)]
-        labels = [f"margin.{n}" for n in names] + [f"tool.{n}" for n in names]
+        safety = obstacles.radii + arm.safety_radius
+        margin = np.linalg.norm(wrist[:, None, :] - centres, axis=-1) - safety
+        commanded = np.linalg.norm(kin.wrist_point(arm, tr.q_cmd[:, :3])[:, None, :] - centres, axis=-1) - safety
+        columns = [margin, commanded, _segment_clearance(wrist, tip, centres, obstacles.radii)]
+        labels = [f"{kind}.{n}" for kind in ("margin", "command_margin", "tool") for n in names]
         if tr.tool_distance is not None:
             columns.append(tr.tool_distance)
             labels += [f"mujoco.{n}" for n in names]
