@@ -88,10 +88,15 @@ def test_pipeline_runs_fig3_and_reports(data_dir):
     assert proc.returncode == 0, proc.stderr
     proc = run_cli("analysis", "experiment=nmpc-cdkd/tracking", f"data_dir={data_dir}")
     assert proc.returncode == 0, proc.stderr
-    metrics = pd.read_parquet(data_dir / "metrics/nmpc-cdkd/tracking.parquet").set_index("metric")["value"]
+    frame = pd.read_parquet(data_dir / "metrics/nmpc-cdkd/tracking.parquet")
+    metrics = frame[frame["run_id"] == "decomposed"].set_index("metric")["value"]
     assert metrics["claim.no_stationary_error"] == 1 and metrics["solve.failures"] == 0
     assert metrics["wrist_error.max"] < 0.1 * metrics["tool_error.max"]
     assert abs(metrics["reference.z_deviation_time"] - 1.2) < 0.1
+    # Sec. 4.2: the same wrist path with a 50 mm rod gives smaller tool errors (the lever: 150 vs 250 mm)
+    short = frame[frame["run_id"] == "decomposed-de50mm"].set_index("metric")["value"]
+    assert short["wrist_error.max"] == pytest.approx(metrics["wrist_error.max"], rel=1e-6)
+    assert short["tool_error.max"] / metrics["tool_error.max"] == pytest.approx(150 / 250, rel=0.05)
     assert (data_dir / "figures/nmpc-cdkd/tracking/fig3-decomposed.png").is_file()
 
 
