@@ -32,12 +32,14 @@ class ArmDynamics:
 
 
 def serial_arm(name: str, dh: DH, dyn: ArmDynamics, *, timestep: float, kp: Sequence[float],
-               kv: Sequence[float], gravity_compensation: bool = True) -> str:
+               kv: Sequence[float], gravity_compensation: bool = True, base_pos: Sequence[float] = (0.0, 0.0, 0.0),
+               flange_xml: str = "", world_xml: str = "") -> str:
     """MJCF of a DH arm driven by a joint PD servo per joint, evaluated every physics step.
 
     Controls are [q_ref (n), q̇_ref (n)]: a position actuator (gain kp) and a velocity actuator
     (gain kv) per joint, so the joint torque is kp·(q_ref − q) + kv·(q̇_ref − q̇) (+ gravity
-    compensation), clamped to ±torque_limit at the joint.
+    compensation), clamped to ±torque_limit at the joint. `base_pos` places DH frame 0 in the world;
+    `flange_xml` adds elements in the last DH frame (a tool), `world_xml` in the world body (obstacles).
     """
     n = dh.n
     for label, seq in (("masses", dyn.masses), ("armature", dyn.armature), ("damping", dyn.damping),
@@ -65,13 +67,14 @@ def serial_arm(name: str, dh: DH, dyn: ArmDynamics, *, timestep: float, kp: Sequ
         # child frame: Tz(d) Tx(a) Rx(alpha)
         body_xml.append(f'{pad}  <frame pos="{_fmt(seg)}" quat="{ca:.17g} {sa:.17g} 0 0">')
         if i == n - 1:
-            body_xml.append(f'{pad}    <site name="flange" size="0.01"/>')
+            body_xml.append(f'{pad}    <site name="flange" size="0.01"/>{flange_xml}')
     closing = [f"{indent * (i + 2)}  </frame>\n{indent * (i + 2)}</body>" for i in reversed(range(n))]
     actuators = "\n".join(
         f'    <position name="pos{i + 1}" joint="joint{i + 1}" kp="{kp[i]:.17g}"/>' for i in range(n)) + "\n" + \
         "\n".join(f'    <velocity name="vel{i + 1}" joint="joint{i + 1}" kv="{kv[i]:.17g}"/>' for i in range(n))
     sensors = "\n".join(f'    <jointactuatorfrc name="tau{i + 1}" joint="joint{i + 1}"/>' for i in range(n))
     joint_opts = ' actuatorgravcomp="true"' if gravity_compensation else ""
+    base = f' pos="{_fmt(base_pos)}"' if any(base_pos) else ""
     return f"""<mujoco model="{name}">
   <compiler angle="radian" autolimits="true"/>
   <option timestep="{timestep:.17g}" integrator="implicitfast"/>
@@ -81,10 +84,10 @@ def serial_arm(name: str, dh: DH, dyn: ArmDynamics, *, timestep: float, kp: Sequ
   </default>
   <worldbody>
     <geom type="cylinder" size="0.06 0.01" pos="0 0 -0.01" rgba="0.3 0.3 0.3 1"/>
-    <body name="base">
+    <body name="base"{base}>
 {chr(10).join(body_xml)}
 {chr(10).join(closing)}
-    </body>
+    </body>{world_xml}
   </worldbody>
   <actuator>
 {actuators}

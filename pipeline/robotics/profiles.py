@@ -25,3 +25,20 @@ def trapezoid(t: np.ndarray, distance: float, duration: float, accel_fraction: f
     a = np.where(rising, a_max, np.where(falling, -a_max, 0.0))
     moving = (t > 0) & (t < duration)
     return s, np.where(moving, v, 0.0), np.where(moving, a, 0.0)
+
+
+# Peaks of |s'|, |s''|, |s'''| of `septic` over τ ∈ [0, 1]
+SEPTIC_PEAKS = (2.1875, 7.513188404399293, 52.5)
+
+
+def septic(tau: np.ndarray) -> np.ndarray:
+    """(4, ...): s = 35τ⁴ − 84τ⁵ + 70τ⁶ − 20τ⁷ and its first three τ-derivatives, the 7th-order rest-to-rest
+    blend from 0 to 1 with zero velocity, acceleration and jerk at both ends. τ outside [0, 1] holds the end."""
+    tau = np.asarray(tau, dtype=float)
+    t = np.clip(tau, 0.0, 1.0)
+    inside = (tau > 0) & (tau < 1)
+    s = t ** 4 * (35 - 84 * t + 70 * t ** 2 - 20 * t ** 3)
+    d1 = 140 * t ** 3 * (1 - t) ** 3
+    d2 = 420 * t ** 2 * (1 - t) ** 2 * (1 - 2 * t)
+    d3 = 840 * t * (1 - t) * (1 - 5 * t + 5 * t ** 2)
+    return np.stack([s, d1 * inside, d2 * inside, d3 * inside])

@@ -1,0 +1,281 @@
+"""Simulate stage of `nmpc-cdkd`: Table 3 (compute time), Fig. 3 (tracking), Figs. 4-5 (fixed obstacles) and
+Figs. 6-7 (moving obstacles). Every run logs the joints, references, errors, obstacle clearances and one record
+per OCP solve (wall time, IPOPT iterations and status), so the analysis can rebuild the paper's tables and figures."""
+
+from __future__ import annotations
+
+import numpy as np
+from omegaconf import DictConfig, OmegaConf
+
+from pipeline.core import schemas
+from pipeline.core.experiment import Case
+from pipeline.core.runlog import RunWriter
+from pipeline.core.timing import log_timings, time_calls
+from pipeline.papers.nmpc_cdkd import kinematics as kin
+from pipeline.papers.nmpc_cdkd import planning
+from pipeline.papers.nmpc_cdkd.kinematics import JOINTS, Arm
+from pipeline.papers.nmpc_cdkd.nmpc import Nmpc, OcpSettings
+from pipeline.papers.nmpc_cdkd.plant import KinematicPlant, MujocoPlant, model_xml
+from pipeline.papers.nmpc_cdkd.simulation import Controller, Move, Obstacles, Trajectory, closed_loop, run
+
+XYZ = ["x", "y", "z"]
+PLANNING_REPEATS = 20
+
+NmpcSolve = schemas.define(
+    "NmpcSolve", "One OCP solve of an NMPC: wall time, CasADi's own total, IPOPT iterations, status and cost.",
+    model="string", seconds="double", solver_seconds="double", iterations="uint32", success="bool",
+    status="string", cost="double",
+)
+
+
+# -- config -> objects -------------------------------------------------------------------------------------
+
+
+def arm_of(cfg: DictConfig) -> Arm:
+    return Arm.from_config(OmegaConf.to_container(cfg.system, resolve=True))
+
+
+def controller_of(cfg: DictConfig) -> Controller:
+    s = cfg.system
+    return Controller(dt=s.dt, control_steps=s.nmpc.control_steps, gain=np.asarray(s.orientation.gain, dtype=float),
+                      desired_from=s.orientation.desired_from, warm_start=s.nmpc.warm_start,
+                      obstacle_prediction=s.nmpc.obstacle_prediction, on_failure=s.nmpc.on_failure,
+                      initial_state=s.nmpc.initial_state,
+                      sample_dt=s.planning.sample_dt, wrist_band=s.planning.wrist_band)
+
+
+def nmpc_of(cfg: DictConfig, arm: Arm, model: str, horizon_steps: int, obstacles: int, band: bool) -> Nmpc:
+    s = cfg.system
+    return Nmpc(arm, OcpSettings(
+        model=model, horizon_steps=horizon_steps, dt=s.dt, mu=tuple(s.nmpc.mu), length_unit=s.nmpc.length_unit,
+        acceleration=s.joint_limits.acceleration, jerk=s.joint_limits.jerk, obstacles=obstacles, height_band=band,
+        integrator=s.nmpc.integrator, cost_quadrature=s.nmpc.cost_quadrature,
+        orientation_lever=s.full.orientation_lever, tol=s.nmpc.tol,
+        acceptable_obj_change_tol=s.nmpc.acceptable_obj_change_tol, max_iter=s.nmpc.max_iter))
+
+
+def tool_pose(cfg: DictConfig, position) -> np.ndarray:
+    """Tool pose at `position` with the scene's orientation (tool pointing down)."""
+    T = np.eye(4)
+    T[:3, :3] = np.diag(cfg.system.scene.tool_axes)
+    T[:3, 3] = position
+    return T
+
+
+def scene_obstacles(cfg: DictConfig, velocities) -> Obstacles:
+    sc = cfg.system.scene
+    radii = np.asarray(sc.obstacles.radii, dtype=float)
+    xy = np.asarray(sc.obstacles.xy, dtype=float)
+    return Obstacles(np.column_stack([xy, sc.ground_z + radii]), np.asarray(velocities, dtype=float), radii)
+
+
+def plant_factory(cfg: DictConfig, arm: Arm, obstacles: Obstacles, log: RunWriter | None):
+    """q0 -> plant; the MuJoCo model (generated at q0) is attached to the run."""
+    p = cfg.system.plant
+
+    def make(q0: np.ndarray):
+        if p.kind == "kinematic":
+            return KinematicPlant(q0)
+        xml = model_xml(arm, p, cfg.system.dt, q0, obstacles.radii)
+        if log is not None:
+            log.attach("model.xml", xml, "application/xml")
+        return MujocoPlant(xml, cfg.system.dt, q0, len(obstacles))
+
+    return make
+
+
+# -- logging -----------------------------------------------------------------------------------------------
+
+
+def _segment_clearance(wrist: np.ndarray, tip: np.ndarray, centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
+    """(n, ν) distance from the tool segment [wrist point, tool tip] to each sphere's surface."""
+    d = (tip - wrist)[:, None, :]
+    s = np.clip(np.sum((centres - wrist[:, None, :]) * d, axis=-1) / np.sum(d * d, axis=-1), 0.0, 1.0)
+    closest = wrist[:, None, :] + s[..., None] * d
+    return np.linalg.norm(centres - closest, axis=-1) - radii
+
+
+def log_trajectory(log: RunWriter, arm: Arm, tr: Trajectory, model: str, obstacles: Obstacles,
+                   names: list[str], offset: float = 0.0) -> None:
+    """Write one closed-loop move; `offset` (s) places it after earlier moves of the same run."""
+    t = tr.t + offset
+    log.log_series("/joint_state", t, name=JOINTS, position=tr.q, velocity=tr.qd, effort=tr.effort)
+    log.log_series("/command", t, kind="position", name=JOINTS, value=tr.q_cmd)
+    log.log_series("/command/velocity", t, kind="velocity", name=JOINTS, value=tr.qd_cmd)
+    log.log_series("/reference", t, name=JOINTS, position=tr.q_ref, velocity=tr.qd_ref)
+    F, F_ref = kin.frames(arm, tr.q), kin.frames(arm, tr.q_ref)
+    tip, tip_ref = (F @ arm.tool)[:, -1, :3, 3], (F_ref @ arm.tool)[:, -1, :3, 3]
+    wrist, wrist_ref = F[:, 4, :3, 3], F_ref[:, 4, :3, 3]
+    log.log_series("/reference/tool", t, name=XYZ, position=tip_ref)
+    log.log_series("/reference/wrist", t, name=XYZ, position=wrist_ref)
+    for topic, err in (("/tracking_error", tip_ref - tip), ("/tracking_error/wrist", wrist_ref - wrist),
+                       ("/tracking_error/orientation", tr.orientation_error)):
+        log.log_series(topic, t, name=XYZ, error=err, norm=np.linalg.norm(err, axis=1))
+    seconds = np.array([s.seconds for s in tr.solves])
+    log.log_series("/compute_time", tr.solve_t + offset, name=[model], calls=[1], seconds=seconds[:, None])
+    log.log_series("/nmpc/solve", tr.solve_t + offset, NmpcSolve, model=model, seconds=seconds,
+                   solver_seconds=np.array([s.solver_seconds for s in tr.solves]),
+                   iterations=np.array([s.iterations for s in tr.solves]),
+                   success=np.array([s.success for s in tr.solves]),
+                   status=np.array([s.status for s in tr.solves]), cost=np.array([s.cost for s in tr.solves]))
+    sel = tr.selection
+    log.log("/planning", offset, schemas.Scalars, name=["seconds", "margin", "candidates", "jump_free"],
+            value=[tr.planning_seconds, sel.margin, sel.candidates, sel.jump_free])
+    frames = [F[:, i] for i in range(1, 7)] + [F[:, 6] @ arm.tool]
+    children = [f"link{i}" for i in range(1, 7)] + ["tool"]
+    if len(obstacles):
+        centres = tr.centres
+        safety = obstacles.radii + arm.safety_radius
+        margin = np.linalg.norm(wrist[:, None, :] - centres, axis=-1) - safety
+        commanded = np.linalg.norm(kin.wrist_point(arm, tr.q_cmd[:, :3])[:, None, :] - centres, axis=-1) - safety
+        columns = [margin, commanded, _segment_clearance(wrist, tip, centres, obstacles.radii)]
+        labels = [f"{kind}.{n}" for kind in ("margin", "command_margin", "tool") for n in names]
+        if tr.tool_distance is not None:
+            columns.append(tr.tool_distance)
+            labels += [f"mujoco.{n}" for n in names]
+        log.log_series("/clearance", t, schemas.Scalars, name=labels, value=np.concatenate(columns, axis=1))
+        log.log_series("/obstacles", t, schemas.Scalars, name=[f"{n}.{a}" for n in names for a in XYZ],
+                       value=centres.reshape(len(t), -1))
+        poses = np.tile(np.eye(4), (len(t), len(names), 1, 1))
+        poses[..., :3, 3] = centres
+        frames += [poses[:, i] for i in range(len(names))]
+        children += [f"obstacle/{n}" for n in names]
+    log.log_transforms(t, "world", children, np.stack(frames, axis=1))
+
+
+# -- E2-E4: the scene of Figs. 2-7 ------------------------------------------------------------------------
+
+
+def _scene_case(cfg: DictConfig, model: str, obstacles: Obstacles, band: tuple[float, float] | None):
+    sc = cfg.scenario
+    arm = arm_of(cfg)
+    move = Move(tool_pose(cfg, sc.start), tool_pose(cfg, sc.goal), sc.t0, sc.t1 - sc.t0, sc.duration, obstacles, band)
+    names = list(cfg.system.scene.obstacles.names)[:len(obstacles)]
+
+    def simulate(log: RunWriter) -> None:
+        # what this case simulated (a case may change the experiment's config, e.g. the rod length)
+        log.attach("case_config.yaml", OmegaConf.to_yaml(cfg, resolve=True), "application/yaml")
+        nmpc = nmpc_of(cfg, arm, model, cfg.system.nmpc.horizon_steps, len(obstacles), band is not None)
+        ctl = controller_of(cfg)
+        tr = run(arm, nmpc, ctl, move, plant_factory(cfg, arm, obstacles, log))
+        log_trajectory(log, arm, tr, model, obstacles, names)
+        # Sec. 4.2 times the planning ("approximately 1 ms"): warm, repeated, like every compute time here
+        plan = time_calls("planning", planning.select_configuration,
+                          [(arm, move.T_start, move.T_goal, round(move.T / ctl.sample_dt) + 1, ctl.wrist_band)],
+                          warmup=3, repeats=PLANNING_REPEATS)
+        log_timings(log, [plan])
+
+    return simulate
+
+
+def tracking(cfg: DictConfig) -> list[Case]:
+    cases = []
+    z_e = np.diag(cfg.system.scene.tool_axes)[:, 2]
+    for d_e in cfg.scenario.tool_lengths:
+        # another rod length moves the tool points along the tool axis, so the wrist path stays the same
+        shift = -(cfg.system.dh.tool_d - d_e) * z_e
+        tool_cfg = OmegaConf.merge(cfg, {"system": {"dh": {"tool_d": d_e}},
+                                         "scenario": {"start": (np.asarray(cfg.scenario.start) + shift).tolist(),
+                                                      "goal": (np.asarray(cfg.scenario.goal) + shift).tolist()}})
+        suffix = "" if d_e == cfg.system.dh.tool_d else f"-de{d_e * 1e3:g}mm"
+        cases += [Case(model + suffix, _scene_case(tool_cfg, model, Obstacles.none(), None))
+                  for model in cfg.scenario.models]
+    return cases
+
+
+def fixed_obstacles(cfg: DictConfig) -> list[Case]:
+    lower, upper = cfg.system.scene.band
+    obstacles = scene_obstacles(cfg, np.zeros((len(cfg.system.scene.obstacles.radii), 3)))
+    bands = {"a": (lower, np.inf), "b": (lower, upper)}
+    return [Case(case, _scene_case(cfg, "decomposed", obstacles, bands[case])) for case in cfg.scenario.cases]
+
+
+def moving_obstacles(cfg: DictConfig) -> list[Case]:
+    band = tuple(cfg.system.scene.band)
+    return [Case(case, _scene_case(cfg, "decomposed", scene_obstacles(cfg, cfg.scenario.velocity[case]), band))
+            for case in cfg.scenario.cases]
+
+
+# -- E1: Table 3 -------------------------------------------------------------------------------------------
+
+
+def random_moves(cfg: DictConfig, arm: Arm) -> list[dict]:
+    """The seeded point-to-point moves of E1, each with its obstacle and height band (same for every run)."""
+    sc, rng = cfg.scenario, np.random.default_rng(cfg.seed)
+    samples = lambda T: round(T / cfg.system.planning.sample_dt) + 1  # noqa: E731 (jump-check samples)
+    limits = cfg.system.joint_limits
+    safety = sc.obstacle.radius + arm.safety_radius
+    moves = []
+    while len(moves) < sc.moves:
+        z = rng.uniform(*sc.tool_z)
+        phi = rng.uniform(-np.pi, np.pi)
+        phi_goal = phi + rng.choice([-1, 1]) * rng.uniform(*sc.azimuth_change)
+        ends = [tool_pose(cfg, [0, 0, z]) for _ in range(2)]
+        for T, a in zip(ends, (phi, phi_goal), strict=True):
+            rho = rng.uniform(*sc.wrist_radius)
+            T[:2, 3] = rho * np.cos(a), rho * np.sin(a)
+        try:
+            sel = planning.select_configuration(arm, ends[0], ends[1], samples(sc.min_transition_time),
+                                                cfg.system.planning.wrist_band)
+        except ValueError:
+            continue
+        T = planning.transition_time(sel.q_start, sel.q_goal, arm.velocity, limits.acceleration, limits.jerk,
+                                     cfg.system.planning.limit_margin, sc.min_transition_time)
+        mid = kin.wrist_point(arm, planning.JointPolynomial(sel.q_start, sel.q_goal, 0.0, T)(np.array([T / 2]))[0, :3])
+        inward = -np.r_[mid[:2], 0.0] / np.linalg.norm(mid[:2])
+        centre = mid + safety * (sc.obstacle.offset * inward - np.array([0, 0, sc.obstacle.drop]))
+        ends_wrist = np.array([kin.wrist_target(arm, T_end) for T_end in ends])
+        if np.linalg.norm(ends_wrist - centre, axis=1).min() < safety + sc.obstacle.clearance:
+            continue
+        z_wrist = ends_wrist[0, 2]
+        moves.append({"T_start": ends[0], "T_goal": ends[1], "T": T, "selection": sel, "centre": centre,
+                      "band": (z_wrist + sc.height_band[0], z_wrist + sc.height_band[1])})
+    return moves
+
+
+def _moves_loop(cfg: DictConfig, arm: Arm, moves: list[dict], model: str, case: str, k: int):
+    """One (model, case, horizon) over all moves, pausing after every OCP solve; returns the trajectories."""
+    sc = cfg.scenario
+    with_obstacle, with_band = case != "no-obstacle", case == "obstacle-height"
+    nmpc = nmpc_of(cfg, arm, model, k, int(with_obstacle), with_band)
+    trajectories = []
+    for m in moves:
+        obstacles = (Obstacles(m["centre"][None], np.zeros((1, 3)), np.array([sc.obstacle.radius]))
+                     if with_obstacle else Obstacles.none())
+        move = Move(m["T_start"], m["T_goal"], sc.t0, m["T"], sc.t0 + m["T"] + sc.settle, obstacles,
+                    m["band"] if with_band else None)
+        tr = yield from closed_loop(arm, nmpc, controller_of(cfg), move, plant_factory(cfg, arm, obstacles, None),
+                                    m["selection"])
+        trajectories.append((tr, obstacles))
+    return trajectories
+
+
+def compute_time(cfg: DictConfig) -> list[Case]:
+    """One run per (model, case, horizon). All of them are simulated together, on the first run's turn: the
+    closed loops advance one OCP solve each in turn (like `time_interleaved`), so a change of load on a shared
+    machine falls on every combination alike and the ratios of Table 3 stay fair."""
+    sc = cfg.scenario
+    arm = arm_of(cfg)
+    combos = [(model, case, k) for model in sc.models for case in sc.cases for k in sc.horizons]
+    results: dict[tuple, list] = {}
+
+    def simulate_all() -> None:
+        moves = random_moves(cfg, arm)
+        active = {combo: _moves_loop(cfg, arm, moves, *combo) for combo in combos}
+        while active:
+            for combo, loop in list(active.items()):
+                try:
+                    next(loop)
+                except StopIteration as done:
+                    results[combo] = done.value
+                    del active[combo]
+
+    def simulate(log: RunWriter, combo: tuple) -> None:
+        if not results:
+            simulate_all()
+        offset = 0.0
+        for tr, obstacles in results[combo]:
+            log_trajectory(log, arm, tr, combo[0], obstacles, ["obstacle"], offset)
+            offset += float(tr.t[-1]) + cfg.system.dt
+
+    return [Case(f"{model}-{case}-k{k}", lambda log, c=(model, case, k): simulate(log, c)) for model, case, k in combos]
