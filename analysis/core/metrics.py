@@ -29,6 +29,12 @@ class MetricTable:
         return frame if not frame.empty else pd.DataFrame(columns=COLUMNS)
 
 
+def metric_value(frame: pd.DataFrame, run_id: str, metric: str) -> float:
+    """One metric of one run from a tidy table; NaN if absent."""
+    hit = frame[(frame["run_id"] == run_id) & (frame["metric"] == metric)]
+    return float(hit["value"].iloc[0]) if not hit.empty else float("nan")
+
+
 def write_metrics(frame: pd.DataFrame, path: Path) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.partial")

@@ -39,6 +39,16 @@ class Timing:
         return {"median_us": float(np.median(per_item)), "p95_us": float(np.percentile(per_item, 95))}
 
 
+def best_of(fn: Callable[[], Any], repeats: int = 3) -> float:
+    """Shortest wall time (s) of `repeats` calls: for whole runs, where the minimum is the least disturbed."""
+    best = float("inf")
+    for _ in range(repeats):
+        start = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
 def time_calls(name: str, fn: Callable[..., Any], inputs: Sequence[tuple], *, warmup: int = 100,
                repeats: int = 1, items_per_call: int = 1) -> Timing:
     """Time `fn(*args)` for each args tuple in `inputs`, `repeats` passes, after `warmup` calls."""

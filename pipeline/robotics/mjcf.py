@@ -8,7 +8,7 @@ geometric Jacobian of the DH model.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -99,6 +99,22 @@ def serial_arm(name: str, dh: DH, dyn: ArmDynamics, *, timestep: float, kp: Sequ
   </sensor>
 </mujoco>
 """
+
+
+def with_servo_gains(build: Callable[[np.ndarray, np.ndarray], str], q0: np.ndarray, bandwidth_hz: float,
+                     damping_ratio: float) -> str:
+    """The MJCF `build(kp, kv)` makes, with each joint servo tuned to a natural frequency and damping ratio at
+    q0: kp = m·ω², kv = 2ζ·m·ω, m the diagonal of the joint-space inertia (armature included) at q0."""
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_string(build(np.zeros(len(q0)), np.zeros(len(q0))))
+    data = mujoco.MjData(model)
+    data.qpos[:] = q0
+    mujoco.mj_forward(model, data)
+    inertia = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, inertia)
+    m, w = np.diag(inertia), 2 * np.pi * bandwidth_hz
+    return build(m * w * w, 2 * damping_ratio * m * w)
 
 
 # MuJoCo does not return NaN when a simulation blows up: it warns and resets the state. These warnings

@@ -10,7 +10,7 @@ from scipy.spatial.transform import Rotation
 from analysis.core.compute_time import compute_time_section, machine_of, timing_metrics
 from analysis.core.errors import error_stats
 from analysis.core.figures import Figures, plt
-from analysis.core.metrics import MetricTable
+from analysis.core.metrics import MetricTable, metric_value
 from pipeline.core.runlog import Run
 
 CHECKS = {"on_curve": "/chain/fk", "poe_on_curve": "/chain/poe", "mujoco_on_curve": "/chain/mujoco"}
@@ -269,10 +269,6 @@ ANALYSES = {"bezier-fig2": analyze_bezier, "timing-fig3": analyze_timing, "snake
 # -- extra report tables ------------------------------------------------------------------------------------
 
 
-def _value(frame: pd.DataFrame, run_id: str, metric: str) -> float:
-    hit = frame[(frame["run_id"] == run_id) & (frame["metric"] == metric)]
-    return float(hit["value"].iloc[0]) if not hit.empty else float("nan")
-
 
 def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]:
     sections = []
@@ -302,20 +298,20 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
         rows = []
         for n in wanted:
             rid = f"joints-{n:03d}"
-            if _value(fig3, rid, "joints") != n:
+            if metric_value(fig3, rid, "joints") != n:
                 continue
-            rows.append({"joints": n, "link": _value(fig3, rid, "segment_length"),
-                         "curve evaluations": _value(fig3, rid, "evaluations"),
-                         **{f"{s} median [µs]": _value(fig3, rid, f"{s}.median") * 1e6 for s in STAGES},
-                         "total p95 [µs]": _value(fig3, rid, "total.p95") * 1e6})
-        fits = ", ".join(f"{s} {_value(fig3, 'all', f'{s}.exponent'):.2f}" for s in STAGES)
+            rows.append({"joints": n, "link": metric_value(fig3, rid, "segment_length"),
+                         "curve evaluations": metric_value(fig3, rid, "evaluations"),
+                         **{f"{s} median [µs]": metric_value(fig3, rid, f"{s}.median") * 1e6 for s in STAGES},
+                         "total p95 [µs]": metric_value(fig3, rid, "total.p95") * 1e6})
+        fits = ", ".join(f"{s} {metric_value(fig3, 'all', f'{s}.exponent'):.2f}" for s in STAGES)
         sections.append(
             "## Time against the number of joints (Fig. 3)\n\n" + pd.DataFrame(rows).to_markdown(index=False,
                                                                                                 floatfmt=".3g")
             + f"\n\nScaling exponents b of T ∝ N^b over 4-100 joints: {fits}; curve evaluations "
-            f"{_value(fig3, 'all', 'evaluations.exponent'):.2f}. Affine fit of the angle stage: "
-            f"{_value(fig3, 'all', 'angles.per_joint') * 1e9:.1f} ns per joint, R² "
-            f"{_value(fig3, 'all', 'angles.linear_r2'):.3f}. The search's cost is the forward march over the "
+            f"{metric_value(fig3, 'all', 'evaluations.exponent'):.2f}. Affine fit of the angle stage: "
+            f"{metric_value(fig3, 'all', 'angles.per_joint') * 1e9:.1f} ns per joint, R² "
+            f"{metric_value(fig3, 'all', 'angles.linear_r2'):.3f}. The search's cost is the forward march over the "
             "whole curve (about 1/dt evaluations whatever N) plus ~24 bisection steps per segment, so it grows "
             "less than linearly from a large constant.")
     snake = metrics.get("snake-gait")
@@ -326,7 +322,7 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
                 "evaluations_warm.mean": ("curve evals, warm", 1), "evaluations_cold.mean": ("curve evals, cold", 1),
                 "torque.max_ratio": ("max torque / limit", 1), "head_travel": ("head travel [m]", 1)}
         gaits = [r for r in snake["run_id"].unique() if r != "all"]
-        rows = [{"gait": g, **{label: _value(snake, g, k) * scale for k, (label, scale) in keys.items()}}
+        rows = [{"gait": g, **{label: metric_value(snake, g, k) * scale for k, (label, scale) in keys.items()}}
                 for g in gaits]
         sections.append(
             "## Snake robot in MuJoCo (the paper's motivating application)\n\nA 30-joint snake (15 segments of "

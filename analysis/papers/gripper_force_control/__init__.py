@@ -16,7 +16,7 @@ import pandas as pd
 
 from analysis.core.errors import error_stats, force_error_stats
 from analysis.core.figures import Figures, plt
-from analysis.core.metrics import MetricTable
+from analysis.core.metrics import MetricTable, metric_value
 from pipeline.core.runlog import Run
 from pipeline.papers.gripper_force_control.drive import move_duration
 
@@ -341,10 +341,6 @@ ANALYSES = {"force-sag": analyze_force_sag, "force-error-surface": analyze_force
 # -- extra report sections -------------------------------------------------------------------------------------
 
 
-def _value(frame: pd.DataFrame, run_id: str, metric: str) -> float:
-    hit = frame[(frame["run_id"] == run_id) & (frame["metric"] == metric)]
-    return float(hit["value"].iloc[0]) if not hit.empty else float("nan")
-
 
 def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]:
     sections = []
@@ -352,13 +348,13 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
     if sag is not None and not sag.empty:
         rows = []
         for run_id in sorted(set(sag.loc[sag["metric"] == "force_error.sag", "run_id"])):
-            rows.append({"run": run_id, "sag [%]": 100 * _value(sag, run_id, "force_error.sag"),
-                         "max |F − F_set| [N]": _value(sag, run_id, "force_error.max"),
-                         "RMS [N]": _value(sag, run_id, "force_error.rms"),
-                         "max rotation error [°]": np.rad2deg(_value(sag, run_id, "rotation_error.max"))})
+            rows.append({"run": run_id, "sag [%]": 100 * metric_value(sag, run_id, "force_error.sag"),
+                         "max |F − F_set| [N]": metric_value(sag, run_id, "force_error.max"),
+                         "RMS [N]": metric_value(sag, run_id, "force_error.rms"),
+                         "max rotation error [°]": np.rad2deg(metric_value(sag, run_id, "rotation_error.max"))})
         pairs = sorted(set(sag.loc[sag["metric"] == "plants.max_force_difference", "run_id"]))
-        agree = [{"case": c, "max |F_mujoco − F_lumped| [N]": _value(sag, c, "plants.max_force_difference"),
-                  "RMS [N]": _value(sag, c, "plants.rms_force_difference")} for c in pairs]
+        agree = [{"case": c, "max |F_mujoco − F_lumped| [N]": metric_value(sag, c, "plants.max_force_difference"),
+                  "RMS [N]": metric_value(sag, c, "plants.rms_force_difference")} for c in pairs]
         sections.append(
             "## Fig. 8: force sag, every run\n\nF_set = 5 N, 40° at ω_max = 5.9 rad/s, ε_max = 73.3 rad/s²; the "
             "window runs from the rotation's start to 0.1 s after its set point stops. `coupling_eq9` runs a plant "
@@ -392,15 +388,15 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
     mc = metrics.get("steady-state")
     if mc is not None and not mc.empty:
         forces = sorted({float(x.rsplit("F", 1)[1]) for x in mc["metric"] if x.startswith("steady_error.max.F")})
-        rows = [{"F_set [N]": f, "max |error| [N]": _value(mc, "grasps", f"steady_error.max.F{f:g}"),
-                 "mean error [N]": _value(mc, "grasps", f"steady_error.mean.F{f:g}")} for f in forces]
+        rows = [{"F_set [N]": f, "max |error| [N]": metric_value(mc, "grasps", f"steady_error.max.F{f:g}"),
+                 "mean error [N]": metric_value(mc, "grasps", f"steady_error.mean.F{f:g}")} for f in forces]
         sections.append(
             "## Fig. 7 stand-in: Monte-Carlo steady-state error (not the hardware result)\n\n"
-            f"{_value(mc, 'grasps', 'grasps'):.0f} grasps on the lumped plant, closing from a random 2-20 mm gap "
+            f"{metric_value(mc, 'grasps', 'grasps'):.0f} grasps on the lumped plant, closing from a random 2-20 mm gap "
             "with M1's Coulomb friction drawn from 0.5-1.5 × the calibrated value; error = mean force over the "
             "last 50 ms − F_set. Paper (strain gauge, 50 grasps per set point): never above 0.8 N, mostly below "
-            f"0.5 N. Here: max {_value(mc, 'grasps', 'steady_error.max'):.2f} N, "
-            f"{100 * _value(mc, 'grasps', 'steady_error.fraction_below_0.5N'):.0f} % below 0.5 N.\n\n"
+            f"0.5 N. Here: max {metric_value(mc, 'grasps', 'steady_error.max'):.2f} N, "
+            f"{100 * metric_value(mc, 'grasps', 'steady_error.fraction_below_0.5N'):.0f} % below 0.5 N.\n\n"
             + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".3f"))
     tables = metrics.get("tables")
     if tables is not None and not tables.empty:

@@ -13,7 +13,7 @@ import pandas as pd
 from analysis.core.compute_time import compute_time_section, machine_of, timing_metrics
 from analysis.core.errors import error_stats
 from analysis.core.figures import Figures, plt
-from analysis.core.metrics import MetricTable
+from analysis.core.metrics import MetricTable, metric_value
 from analysis.core.targets import load_targets
 from pipeline.core.runlog import Run
 
@@ -339,10 +339,6 @@ ANALYSES = {"compute-time": analyze_compute_time, "tracking": analyze_tracking,
 # -- extra report tables -----------------------------------------------------------------------------------
 
 
-def _value(frame: pd.DataFrame, run_id: str, metric: str) -> float:
-    hit = frame[(frame["run_id"] == run_id) & (frame["metric"] == metric)]
-    return float(hit["value"].iloc[0]) if not hit.empty else float("nan")
-
 
 TRAJECTORY_COLUMNS = [  # (metric, column, factor from SI)
     ("tool_error.max", "max ‖p̃‖ [mm]", 1e3), ("tool_error.rms", "RMS ‖p̃‖ [mm]", 1e3),
@@ -365,20 +361,21 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
             model, case, k = _combo(run_id)
             paper = paper_table3().get((model, case, k))
             rows.append({"movement": CASE_LABELS[case], "horizon": f"N{1 if k == 10 else 2} (k = {k})", "model": model,
-                         "t̄ ± σ [ms]": f"{_value(ct, run_id, 'solve.mean') * 1e3:.1f} ± "
-                                       f"{_value(ct, run_id, 'solve.std') * 1e3:.1f}",
+                         "t̄ ± σ [ms]": f"{metric_value(ct, run_id, 'solve.mean') * 1e3:.1f} ± "
+                                       f"{metric_value(ct, run_id, 'solve.std') * 1e3:.1f}",
                          "paper t̄ ± σ [ms]": f"{paper[0]:g} ± {paper[1]:g}" if paper else "",
-                         "median [ms]": _value(ct, run_id, "solve.median") * 1e3,
-                         "p95 [ms]": _value(ct, run_id, "solve.p95") * 1e3,
-                         "IPOPT iterations": _value(ct, run_id, "solve.iterations_mean"),
-                         "failed solves": int(_value(ct, run_id, "solve.failures")),
-                         "> 40 ms": _value(ct, run_id, "solve.over_control_horizon"),
-                         "samples": int(_value(ct, run_id, "solve.samples"))})
+                         "median [ms]": metric_value(ct, run_id, "solve.median") * 1e3,
+                         "p95 [ms]": metric_value(ct, run_id, "solve.p95") * 1e3,
+                         "IPOPT iterations": metric_value(ct, run_id, "solve.iterations_mean"),
+                         "failed solves": int(metric_value(ct, run_id, "solve.failures")),
+                         "> 40 ms": metric_value(ct, run_id, "solve.over_control_horizon"),
+                         "samples": int(metric_value(ct, run_id, "solve.samples"))})
         table = pd.DataFrame(rows).to_markdown(index=False, floatfmt=".3g")
-        ratio_rows = [{"movement": CASE_LABELS[c], **{f"dec/full N{i + 1}": _value(ct, "table3", f"ratio.{c}.k{k}")
+        ratio_rows = [{"movement": CASE_LABELS[c],
+                       **{f"dec/full N{i + 1}": metric_value(ct, "table3", f"ratio.{c}.k{k}")
                                                        for i, k in enumerate((10, 20))},
-                       "growth N1→N2 dec": _value(ct, "table3", f"growth.decomposed.{c}"),
-                       "growth N1→N2 full": _value(ct, "table3", f"growth.full.{c}")} for c in CASE_LABELS]
+                       "growth N1→N2 dec": metric_value(ct, "table3", f"growth.decomposed.{c}"),
+                       "growth N1→N2 full": metric_value(ct, "table3", f"growth.full.{c}")} for c in CASE_LABELS]
         sections.append(
             "## Table 3: OCP solve time per step\n\nEach NMPC runs its own closed loop (ideal kinematic plant) over "
             "the same seeded random point-to-point moves; the 12 loops advance one solve each in turn, so machine "

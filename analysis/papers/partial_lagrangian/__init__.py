@@ -12,7 +12,7 @@ from scipy.optimize import fsolve
 from analysis.core.compute_time import compute_time_section, machine_of, timing_metrics
 from analysis.core.errors import error_stats
 from analysis.core.figures import Figures, plt
-from analysis.core.metrics import MetricTable
+from analysis.core.metrics import MetricTable, metric_value
 from pipeline.core.runlog import Run
 from pipeline.papers.partial_lagrangian.chain import from_config, gravity_torque
 
@@ -354,10 +354,6 @@ ANALYSES = {"one-link": analyze_pendulum, "two-link": analyze_pendulum, "three-l
 # -- extra report tables -----------------------------------------------------------------------------------
 
 
-def _value(frame: pd.DataFrame, run_id: str, metric: str) -> float:
-    hit = frame[(frame["run_id"] == run_id) & (frame["metric"] == metric)]
-    return float(hit["value"].iloc[0]) if not hit.empty else float("nan")
-
 
 def _pd_section(metrics: dict[str, pd.DataFrame]) -> str | None:
     rows = []
@@ -368,7 +364,7 @@ def _pd_section(metrics: dict[str, pd.DataFrame]) -> str | None:
         finals = frame[(frame["run_id"] == "pd") & frame["metric"].str.match(r"theta\d+\.final$")]
         for metric in finals["metric"]:
             joint = metric.split(".")[0]
-            value = {key: _value(frame, "pd", f"{joint}.{key}") for key in
+            value = {key: metric_value(frame, "pd", f"{joint}.{key}") for key in
                      ("final", "steady_error", "equilibrium", "settling_time", "overshoot")}
             final, steady = np.degrees(value["final"]), np.degrees(value["steady_error"])
             rows.append({"experiment": experiment, "joint": joint, "reference [°]": final + steady,
@@ -389,7 +385,7 @@ def _per_n_table(ct: pd.DataFrame, run_id: str, ns: list[int], columns: list[tup
     for n in ns:
         row = {"n": n}
         for kind, method in columns:
-            med, p95 = (_value(ct, run_id, f"{kind}.{method}.n{n}.{stat}") * 1e6 for stat in ("median", "p95"))
+            med, p95 = (metric_value(ct, run_id, f"{kind}.{method}.n{n}.{stat}") * 1e6 for stat in ("median", "p95"))
             row[f"{kind} {method}"] = f"{med:.3g} ({p95:.3g})"
         rows.append(row)
     return pd.DataFrame(rows).to_markdown(index=False)
@@ -409,10 +405,11 @@ def _compute_time_sections(ct: pd.DataFrame, runs: pd.DataFrame) -> list[str]:
              "`rollout` of one mj_step per state. The paper prints no times (Fig. 5b is an image); its own model of "
              "the figure is the term counts of eqs. (28)-(29), beside ours below.")
     eq28, eq29 = paper_term_counts(np.array(ns))
-    ops = pd.DataFrame({"n": ns, **{f"ops {m}": [f"{_value(ct, run_id, f'ops.{m}.n{n}'):.0f}" for n in ns]
+    ops = pd.DataFrame({"n": ns, **{f"ops {m}": [f"{metric_value(ct, run_id, f'ops.{m}.n{n}'):.0f}" for n in ns]
                                    for m in ("full", "partial", "column")},
                         "eq. 28": [f"{x:.0f}" for x in eq28], "eq. 29": [f"{x:.0f}" for x in eq29]})
-    slopes = pd.DataFrame([{"quantity": label, **{METHODS[m]: _value(ct, run_id, f"slope.{kind}.{m}") for m in METHODS}}
+    slopes = pd.DataFrame([{"quantity": label,
+                             **{METHODS[m]: metric_value(ct, run_id, f"slope.{kind}.{m}") for m in METHODS}}
                            for kind, label in KINDS.items()])
     text = ("## Compute time by number of links\n\nMedian (p95) in µs per call, one thread. `eval`: q̈ by AD of "
             "the full Lagrangian, of the summed partial Lagrangians, and by MuJoCo. `terms`: the coefficients (M, b) "
@@ -453,8 +450,9 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
         sections.append(pd_text)
     one = metrics.get("one-link")
     if one is not None and "free-listing" in set(one["run_id"]):
-        free, pd_ = (np.degrees(_value(one, f"{case}-listing", "listing_deviation.max")) for case in ("free", "pd"))
-        decay, theory = (_value(one, "free", key) for key in ("decay_rate", "decay_rate.linear_theory"))
+        free, pd_ = (np.degrees(metric_value(one, f"{case}-listing", "listing_deviation.max"))
+                     for case in ("free", "pd"))
+        decay, theory = (metric_value(one, "free", key) for key in ("decay_rate", "decay_rate.linear_theory"))
         sections.append(
             "## One link (Fig. 1): decay, and Listing A1 against the Lagrange equations\n\n"
             f"The free link's swing decays at {decay:.4f} 1/s over its later swings (linear theory {theory:.4f} 1/s, "

@@ -17,7 +17,7 @@ from matplotlib import ticker
 from analysis.core.compute_time import compute_time_section, machine_of, timing_metrics
 from analysis.core.errors import error_stats
 from analysis.core.figures import Figures, plt
-from analysis.core.metrics import MetricTable
+from analysis.core.metrics import MetricTable, metric_value
 from pipeline.core.runlog import Run
 from pipeline.papers.scara_half_derivative.arm import Arm
 
@@ -393,10 +393,6 @@ PAPER_TABLE2 = {  # Table 2 as printed: KD, KDHD, KHD (mm, Nm, m²s)
 SCALE = {"e": 1e3}   # m -> mm for the error rows
 
 
-def _value(frame: pd.DataFrame, run_id: str, metric: str) -> float:
-    hit = frame[(frame["run_id"] == run_id) & (frame["metric"] == metric)]
-    return float(hit["value"].iloc[0]) if not hit.empty else float("nan")
-
 
 def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]:
     sections = []
@@ -408,8 +404,8 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
                 scale = SCALE.get(metric.split(".")[0], 1.0)
                 row = {"index": metric}
                 for name, printed in zip(("kd", "kdhd", "khd"), paper, strict=True):
-                    value = _value(table2, f"{name}-k{k}", metric) * scale
-                    pct = _value(table2, f"{name}-k{k}", f"pct.{metric}")
+                    value = metric_value(table2, f"{name}-k{k}", metric) * scale
+                    pct = metric_value(table2, f"{name}-k{k}", f"pct.{metric}")
                     row[f"{name.upper()}"] = f"{value:.4g}" + (f" ({100 * pct:+.1f}%)" if np.isfinite(pct) else "")
                     row[f"paper {name.upper()}"] = printed
                 rows.append(row)
@@ -427,9 +423,10 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
     if maps is not None and not maps.empty:
         rows = []
         for sid in sorted({r for r in maps["run_id"] if r.startswith("k") and "-" not in r}):
-            rows.append({"stiffness": sid, "ICE of KD [N²m²s]": _value(maps, sid, "ice.kd"),
-                         "points": _value(maps, sid, "locus.points"), "slope [s^-½]": _value(maps, sid, "locus.slope"),
-                         "intercept [Ns^½/m]": _value(maps, sid, "locus.intercept"),
+            rows.append({"stiffness": sid, "ICE of KD [N²m²s]": metric_value(maps, sid, "ice.kd"),
+                         "points": metric_value(maps, sid, "locus.points"),
+                         "slope [s^-½]": metric_value(maps, sid, "locus.slope"),
+                         "intercept [Ns^½/m]": metric_value(maps, sid, "locus.intercept"),
                          "paper (eq. 20)": "−9.44, 47,200"})
         lonely = [r["stiffness"] for r in rows if r["points"] < 2]
         sections.append("## Equal-ICE locus fitted from the maps (Fig. 6, eq. 20)\n\nFor each hd_xyz of the grid, "

@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 from analysis.core.compute_time import compute_time_section, machine_of, timing_metrics
 from analysis.core.errors import error_stats
 from analysis.core.figures import Figures, plt
-from analysis.core.metrics import MetricTable
+from analysis.core.metrics import MetricTable, metric_value
 from pipeline.core.runlog import Run
 
 # "converges to zero" / "reached accurately" (Figs. 13a, 14a, 16), made a rule: final position error below
@@ -33,10 +33,6 @@ PRINTED_IK = {"A": [[0.7992, 0.1912, -0.5698, 0.0016], [-0.5579, -0.1939, -0.771
 def _columns(frame: pd.DataFrame, prefix: str, names) -> np.ndarray:
     return frame[[f"{prefix}.{k}" for k in names]].to_numpy()
 
-
-def _value(frame: pd.DataFrame, run_id: str, metric: str) -> float:
-    hit = frame[(frame["run_id"] == run_id) & (frame["metric"] == metric)]
-    return float(hit["value"].iloc[0]) if not hit.empty else float("nan")
 
 
 # -- E1: joint-model ----------------------------------------------------------------------------------------
@@ -342,15 +338,15 @@ def _joint_section(frame: pd.DataFrame) -> str:
     rows = []
     for run_id in sorted(set(frame["run_id"])):
         rows.append({"plant-model": run_id,
-                     "peak rot. err [deg]": np.degrees(_value(frame, run_id, "rotation_error.peak")),
-                     **{f"mean |{a}| [deg]": np.degrees(_value(frame, run_id, f"rotation_error.{a}.mean"))
+                     "peak rot. err [deg]": np.degrees(metric_value(frame, run_id, "rotation_error.peak")),
+                     **{f"mean |{a}| [deg]": np.degrees(metric_value(frame, run_id, f"rotation_error.{a}.mean"))
                         for a in EULER},
-                     "joint vel. err (rel.)": _value(frame, run_id, "joint_velocity_error.relative"),
-                     "spatial vel. err (rel.)": _value(frame, run_id, "spatial_velocity_error.relative"),
-                     "rotation travelled [deg]": np.degrees(_value(frame, run_id, "plant.rotation_travelled"))})
+                     "joint vel. err (rel.)": metric_value(frame, run_id, "joint_velocity_error.relative"),
+                     "spatial vel. err (rel.)": metric_value(frame, run_id, "spatial_velocity_error.relative"),
+                     "rotation travelled [deg]": np.degrees(metric_value(frame, run_id, "plant.rotation_travelled"))})
     contact = ("mujoco-corrected", ["contact.penetration_max", "contact.path_lower", "contact.path_mismatch",
                                     "plant.tangent_rate_error_mean", "plant.spin_rate_max"])
-    details = ", ".join(f"{k} = {_value(frame, contact[0], k):.3g}" for k in contact[1])
+    details = ", ".join(f"{k} = {metric_value(frame, contact[0], k):.3g}" for k in contact[1])
     return ("## Joint model against the plants (Figs. 8-10)\n\nThe paper's model is fed the Ω^B each plant "
             "realised; 'printed-radius' runs eqs. (1), (5), (13)-(16) as printed, 'printed-sign' Table I's sign of "
             "Φ_v. "
@@ -364,14 +360,15 @@ def _joint_section(frame: pd.DataFrame) -> str:
 def _reach_section(frame: pd.DataFrame) -> str:
     rows = []
     for run_id in sorted(set(frame["run_id"]) - {"random"}):
-        rows.append({"run": run_id, "IK converged": bool(_value(frame, run_id, "ik.converged")),
-                     "IK |e_p| [mm]": _value(frame, run_id, "ik.position_error") * 1e3,
-                     "IK e_o [deg]": np.degrees(_value(frame, run_id, "ik.orientation_error")),
-                     **{f"final e_{a} [mm]": _value(frame, run_id, f"final.position_error.{a}") * 1e3 for a in "xyz"},
-                     **{f"final {a} [deg]": np.degrees(_value(frame, run_id, f"final.orientation_error.{a}"))
+        rows.append({"run": run_id, "IK converged": bool(metric_value(frame, run_id, "ik.converged")),
+                     "IK |e_p| [mm]": metric_value(frame, run_id, "ik.position_error") * 1e3,
+                     "IK e_o [deg]": np.degrees(metric_value(frame, run_id, "ik.orientation_error")),
+                     **{f"final e_{a} [mm]": metric_value(frame, run_id, f"final.position_error.{a}") * 1e3
+                        for a in "xyz"},
+                     **{f"final {a} [deg]": np.degrees(metric_value(frame, run_id, f"final.orientation_error.{a}"))
                         for a in EULER},
-                     "|Δp vs nominal| [mm]": _value(frame, run_id, "deviation.position") * 1e3,
-                     "Δθ vs nominal [deg]": np.degrees(_value(frame, run_id, "deviation.orientation"))})
+                     "|Δp vs nominal| [mm]": metric_value(frame, run_id, "deviation.position") * 1e3,
+                     "Δθ vs nominal [deg]": np.degrees(metric_value(frame, run_id, "deviation.orientation"))})
     return ("## Reaching poses (Figs. 13-14) and the hardware stand-in\n\nIK from the Table II start, then the "
             "trolleys. Plants: `nominal` steers by the measured contact point ((53)-(55) online, FreeBOT-SIM); the "
             "others by wheel encoders only, with the EVA foam compressed by 1 mm and/or 2 % of the forward travel "
@@ -384,14 +381,15 @@ def _reach_section(frame: pd.DataFrame) -> str:
 
 def _obstacle_section(frame: pd.DataFrame) -> str:
     rows = [{"case": run_id,
-             **{f"min clearance {bar} [mm]": _value(frame, run_id, f"clearance.{bar}.min") * 1e3
+             **{f"min clearance {bar} [mm]": metric_value(frame, run_id, f"clearance.{bar}.min") * 1e3
                 for bar in ("bar1", "bar2")},
-             "MuJoCo min [mm]": _value(frame, run_id, "clearance.mujoco_min") * 1e3,
-             "|analytic − MuJoCo| [m]": _value(frame, run_id, "clearance.mujoco_difference_max"),
-             "final |e_p| [mm]": _value(frame, run_id, "final.position_error") * 1e3,
-             "final e_o [deg]": np.degrees(_value(frame, run_id, "final.orientation_error")),
-             "t(|e_p| < 1 mm) [s]": _value(frame, run_id, "time_to_1mm"),
-             "max level-1 slack": _value(frame, run_id, "qp.slack_max")} for run_id in sorted(set(frame["run_id"]))]
+             "MuJoCo min [mm]": metric_value(frame, run_id, "clearance.mujoco_min") * 1e3,
+             "|analytic − MuJoCo| [m]": metric_value(frame, run_id, "clearance.mujoco_difference_max"),
+             "final |e_p| [mm]": metric_value(frame, run_id, "final.position_error") * 1e3,
+             "final e_o [deg]": np.degrees(metric_value(frame, run_id, "final.orientation_error")),
+             "t(|e_p| < 1 mm) [s]": metric_value(frame, run_id, "time_to_1mm"),
+             "max level-1 slack": metric_value(frame, run_id, "qp.slack_max")}
+            for run_id in sorted(set(frame["run_id"]))]
     return ("## Target C between the bars (Figs. 16-17)\n\nBars parallel to x through the Table II points, radius "
             "5 mm (assumed); dampers act below 40 mm with gain 0.5 s⁻¹ and keep 10 mm (the paper's safety distance). "
             "`unconstrained` is the same loop without the dampers.\n\n"

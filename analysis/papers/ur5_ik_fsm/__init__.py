@@ -10,7 +10,7 @@ import pandas as pd
 
 from analysis.core.compute_time import compute_time_section, machine_of, timing_metrics
 from analysis.core.figures import Figures, plt
-from analysis.core.metrics import MetricTable
+from analysis.core.metrics import MetricTable, metric_value
 from analysis.core.targets import load_targets
 from pipeline.core.runlog import Run
 from pipeline.papers.ur5_ik_fsm.kinematics import Geometry, shoulder_term
@@ -224,21 +224,17 @@ ANALYSES = {"tables": analyze_tables, "singular-paths": analyze_singular_paths,
 # -- extra report tables -----------------------------------------------------------------------------
 
 
-def _value(frame: pd.DataFrame, run_id: str, metric: str) -> float:
-    hit = frame[(frame["run_id"] == run_id) & (frame["metric"] == metric)]
-    return float(hit["value"].iloc[0]) if not hit.empty else float("nan")
-
 
 def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]:
     sections = []
     tables = metrics.get("tables")
     if tables is not None and "sequential" in set(tables["run_id"]):
-        rows = [{"test": k, **{f"diff Alg {a[-1]} [rad]": _value(tables, "sequential", f"{a}.test{k}.diff")
+        rows = [{"test": k, **{f"diff Alg {a[-1]} [rad]": metric_value(tables, "sequential", f"{a}.test{k}.diff")
                                for a in ALGORITHMS},
-                 "same set": bool(_value(tables, "sequential", f"agreement.test{k}"))} for k in range(1, 11)]
+                 "same set": bool(metric_value(tables, "sequential", f"agreement.test{k}"))} for k in range(1, 11)]
         sections.append("## Sequential variant (our extension)\n\nThe 10 poses in order, each algorithm starting "
                         "from its own previous selection instead of 0. Agreement: "
-                        f"{_value(tables, 'sequential', 'agreement.count'):.0f}/10.\n\n"
+                        f"{metric_value(tables, 'sequential', 'agreement.count'):.0f}/10.\n\n"
                         + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".4f"))
     paths = metrics.get("singular-paths")
     if paths is not None:
@@ -263,7 +259,7 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
     if ct is not None and not ct.empty:
         rows = [(f"Algorithm {name[3]}" + (" (batched, per pose)" if "batch" in name else " (per call)"), name,
                  "not reported") for name in ("alg1", "alg2", "alg1_batch", "alg2_batch")]
-        sets = ", ".join(f"Algorithm {a[-1]} {_value(ct, 'random-poses', f'{a}.sets_evaluated_mean'):.2f}"
+        sets = ", ".join(f"Algorithm {a[-1]} {metric_value(ct, 'random-poses', f'{a}.sets_evaluated_mean'):.2f}"
                          for a in ALGORITHMS)
         sections.append(compute_time_section(
             "Compute time", ct, "random-poses", rows, machine_of(runs, "compute-time"),

@@ -8,12 +8,11 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 from pipeline.core.checks import compose_config
 from pipeline.core.runlog import RunWriter
-from pipeline.core.timing import time_calls
+from pipeline.core.timing import best_of, time_calls
 from pipeline.papers.curve_discretization import algorithm as dc
 from pipeline.papers.curve_discretization import experiments as ex
 from pipeline.papers.curve_discretization import snake as sn
@@ -32,14 +31,6 @@ t = time_calls("total", dc.discretize, [(curve, chain, cfg.system.theta_x0, *ex.
 print(json.dumps(t.summary_us()))
 """
 
-
-def _best_of(fn, repeats: int = 3) -> float:
-    best = float("inf")
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - start)
-    return best
 
 
 def algorithm_per_call(rows: list[dict]) -> None:
@@ -95,7 +86,7 @@ def snake_speed(rows: list[dict]) -> None:
                 ex.log_gait(log, run, chain, xml, ctl.tf_dt)
                 log.close("ok")
 
-        t_bare, t_run, t_log = _best_of(bare), _best_of(controlled), _best_of(logging_only)
+        t_bare, t_run, t_log = best_of(bare), best_of(controlled), best_of(logging_only)
     system = f"MuJoCo snake, {sc.joints} joints, lateral undulation ({sc.duration:g} s, 1 kHz, algorithm at 100 Hz)"
     rows += [
         {"what": system, "measure": "bare mj_step", "value": t_bare / steps * 1e6, "unit": "µs/step"},

@@ -41,10 +41,8 @@ class KinematicPlant:
 
 
 def model_xml(arm: Arm, plant: Mapping, dt: float, q0: np.ndarray, obstacle_radii: np.ndarray) -> str:
-    """MJCF of the TX2-90 with the servo gains set for q0: kp = m ω², kv = 2ζ m ω (m: joint-space inertia)."""
-    import mujoco
-
-    from pipeline.robotics.mjcf import ArmDynamics, serial_arm
+    """MJCF of the TX2-90 with the servo gains set for q0 (`with_servo_gains`)."""
+    from pipeline.robotics.mjcf import ArmDynamics, serial_arm, with_servo_gains
 
     dyn = ArmDynamics(masses=list(plant["masses"]), link_radius=plant["link_radius"],
                       armature=list(plant["armature"]), damping=list(plant["damping"]),
@@ -64,14 +62,7 @@ def model_xml(arm: Arm, plant: Mapping, dt: float, q0: np.ndarray, obstacle_radi
         return serial_arm("tx2_90", arm.dh, dyn, timestep=plant["physics_dt"], kp=list(kp), kv=list(kv),
                           base_pos=arm.base[:3, 3], flange_xml=tool, world_xml=ground + spheres)
 
-    model = mujoco.MjModel.from_xml_string(build(np.zeros(6), np.zeros(6)))
-    data = mujoco.MjData(model)
-    data.qpos[:] = q0
-    mujoco.mj_forward(model, data)
-    M = np.zeros((model.nv, model.nv))
-    mujoco.mj_fullM(model, data, M)
-    m, w = np.diag(M), 2 * np.pi * plant["bandwidth_hz"]
-    return build(m * w * w, 2 * plant["damping_ratio"] * m * w)
+    return with_servo_gains(build, q0, plant["bandwidth_hz"], plant["damping_ratio"])
 
 
 class MujocoPlant:

@@ -4,7 +4,6 @@ chain, and the per-call time of one dynamics evaluation beside the paper's (whic
 from __future__ import annotations
 
 import tempfile
-import time
 from functools import partial
 from pathlib import Path
 
@@ -13,19 +12,10 @@ import numpy as np
 
 from pipeline.core.checks import compose_config
 from pipeline.core.runlog import RunWriter
-from pipeline.core.timing import time_interleaved
+from pipeline.core.timing import best_of, time_interleaved
 from pipeline.papers.partial_lagrangian import experiments as ex
 from pipeline.papers.partial_lagrangian import lagrangian as lg
 from pipeline.papers.partial_lagrangian.rollout import Gains, simulate
-
-
-def _best_of(fn, repeats: int = 3) -> float:
-    best = float("inf")
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - start)
-    return best
 
 
 def runs(rows: list[dict]) -> None:
@@ -45,15 +35,15 @@ def runs(rows: list[dict]) -> None:
             mujoco.mj_step(model, data)
 
     traj = simulate(chain, q0, q0, free, dt, duration)
-    t_ad = _best_of(lambda: simulate(chain, q0, q0, free, dt, duration))
+    t_ad = best_of(lambda: simulate(chain, q0, q0, free, dt, duration))
     with tempfile.TemporaryDirectory() as tmp:
         def logging_only() -> None:
             with RunWriter(Path(tmp) / "b.mcap", {"run_id": "b"}) as log:
                 ex.log_trajectory(log, cfg, chain, traj, free)
                 log.close("ok")
 
-        t_log = _best_of(logging_only)
-    t_mj = _best_of(bare_mujoco)
+        t_log = best_of(logging_only)
+    t_mj = best_of(bare_mujoco)
     what = f"10-link chain, {duration:g} s at dt = {dt * 1e3:g} ms"
     rows += [
         {"what": what, "measure": "AD rollout (graph built + CasADi mapaccum), simulated s per wall s",

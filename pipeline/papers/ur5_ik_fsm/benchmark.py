@@ -4,7 +4,6 @@ compiled `ur-analytic-ik` as a peer when the [bench] extra is installed)."""
 from __future__ import annotations
 
 import tempfile
-import time
 from math import pi
 from pathlib import Path
 
@@ -12,19 +11,10 @@ import numpy as np
 
 from pipeline.core.checks import compose_config
 from pipeline.core.runlog import RunWriter
-from pipeline.core.timing import time_calls
+from pipeline.core.timing import best_of, time_calls
 from pipeline.papers.ur5_ik_fsm import experiments as ex
 from pipeline.papers.ur5_ik_fsm import ik
 from pipeline.robotics import dh as dhk
-
-
-def _best_of(fn, repeats: int = 5) -> float:
-    best = float("inf")
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - start)
-    return best
 
 
 def execution(rows: list[dict]) -> None:
@@ -48,7 +38,7 @@ def execution(rows: list[dict]) -> None:
             step(model, data)
 
     states, sensors = ex.run_servo(xml, q_ref, qd_ref, times)
-    t_bare, t_servo = _best_of(bare), _best_of(lambda: ex.run_servo(xml, q_ref, qd_ref, times))
+    t_bare, t_servo = best_of(bare, 5), best_of(lambda: ex.run_servo(xml, q_ref, qd_ref, times), 5)
     system = "MuJoCo UR5, wrist path (4 s, 1 kHz)"
     rows += [
         {"what": system, "measure": "bare mj_step loop", "value": t_bare / steps * 1e6, "unit": "µs/step"},
@@ -68,7 +58,7 @@ def execution(rows: list[dict]) -> None:
                 ex.run_servo(xml, q_ref, qd_ref, times)
                 logging_only()
 
-            t_full, t_log = _best_of(full), _best_of(logging_only)
+            t_full, t_log = best_of(full, 5), best_of(logging_only, 5)
             rate = f"log_dt = {log_dt * 1e3:g} ms ({label})"
             rows += [
                 {"what": system, "measure": f"logging, {rate}", "value": t_log / steps * 1e6, "unit": "µs/step"},

@@ -138,21 +138,6 @@ def flange_path(kind: str, spec: DictConfig, g: Geometry, times: np.ndarray, dur
     return poses
 
 
-def _servo_gains(xml_builder, q0: np.ndarray, bandwidth_hz: float, zeta: float):
-    """kp = m·ω², kv = 2ζ·m·ω with m the joint-space inertia diagonal at the start pose."""
-    import mujoco
-
-    model = mujoco.MjModel.from_xml_string(xml_builder(np.zeros(6), np.zeros(6)))
-    data = mujoco.MjData(model)
-    data.qpos[:] = q0
-    mujoco.mj_forward(model, data)
-    M = np.zeros((model.nv, model.nv))
-    mujoco.mj_fullM(model, data, M)
-    m = np.diag(M)
-    w = 2 * pi * bandwidth_hz
-    return m * w * w, 2 * zeta * m * w
-
-
 def servo_references(q_ik: np.ndarray, ik_times: np.ndarray, dt: float, unwrap: bool, velocity_limit: float):
     """IK samples -> servo references at every physics step: (times, q_ref, q̇_ref)."""
     held = q_ik.copy()
@@ -169,7 +154,7 @@ def servo_references(q_ik: np.ndarray, ik_times: np.ndarray, dt: float, unwrap: 
 
 def arm_model(cfg: DictConfig, g: Geometry, q0: np.ndarray) -> str:
     """MJCF of the UR5 of Table 1 with the assumed dynamics and servo gains tuned at q0."""
-    from pipeline.robotics.mjcf import ArmDynamics, serial_arm
+    from pipeline.robotics.mjcf import ArmDynamics, serial_arm, with_servo_gains
 
     ex, dyn_cfg = cfg.execute, cfg.system.dynamics
     dyn = ArmDynamics(masses=list(dyn_cfg.masses), link_radius=dyn_cfg.link_radius, armature=list(dyn_cfg.armature),
@@ -179,7 +164,7 @@ def arm_model(cfg: DictConfig, g: Geometry, q0: np.ndarray) -> str:
     def build(kp, kv) -> str:
         return serial_arm("ur5_paper_dh", dh, dyn, timestep=ex.dt, kp=list(kp), kv=list(kv))
 
-    return build(*_servo_gains(build, q0, ex.bandwidth_hz, ex.damping_ratio))
+    return with_servo_gains(build, q0, ex.bandwidth_hz, ex.damping_ratio)
 
 
 def run_servo(xml: str, q_ref: np.ndarray, qd_ref: np.ndarray, times: np.ndarray):
