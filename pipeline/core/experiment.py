@@ -16,10 +16,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
+from typing import TYPE_CHECKING
 
 from omegaconf import DictConfig
 
-from pipeline.core.runlog import RunWriter
+if TYPE_CHECKING:  # the run-file machinery (pandas, MCAP) is not needed to find an experiment
+    from pipeline.core.runlog import RunWriter
 
 CONF_DIR = Path(__file__).resolve().parents[2] / "conf"
 
