@@ -79,3 +79,16 @@ def test_error_stats_closed_form():
     assert s["e.ise"][0] == pytest.approx(0.5, rel=1e-5) and s["e.mean"][0] == pytest.approx(2 / np.pi, rel=2e-3)
     f = force_error_stats(t, np.full_like(t, 9.0), np.full_like(t, 10.0))
     assert f["force_error.max"][0] == pytest.approx(1.0) and f["force_error.sag"][0] == pytest.approx(0.1)
+
+
+def test_a_target_of_a_failed_run_says_why():
+    import pandas as pd
+
+    from analysis.core.targets import evaluate
+
+    targets = pd.DataFrame([{"target_id": "x", "category": "tracking errors", "quantity": "q", "where": "T1",
+                             "value": "1", "unit": "m", "mode": "exact", "op": "==", "tolerance": "0.1",
+                             "experiment": "e", "run": "r", "metric": "m", "note": ""}])
+    runs = pd.DataFrame([{"experiment": "e", "run_id": "r", "status": "failed: diverged at t = 1 s", "ok": False}])
+    row = evaluate("s", targets, {"e": pd.DataFrame(columns=["run_id", "metric", "value", "unit"])}, runs).iloc[0]
+    assert row["status"] == "miss" and "failed: diverged at t = 1 s" in row["note"]

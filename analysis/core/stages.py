@@ -72,8 +72,8 @@ def write_report(data_dir: Path) -> Path:
         info = report.load_paper_info(package_dir)
         metrics_dir = data_dir / "metrics" / slug
         metrics = read_metrics(sorted(metrics_dir.glob("*.parquet")))
-        evaluated = evaluate(slug, load_targets(package_dir / "targets.csv"), metrics)
         runs = _runs_table(metrics_dir)
+        evaluated = evaluate(slug, load_targets(package_dir / "targets.csv"), metrics, runs)
         sections = package.report_sections(metrics, runs) if hasattr(package, "report_sections") and metrics else []
         figures = sorted((data_dir / "figures" / slug).glob("*/*.png"))
         report.write_page(report_dir / f"{slug}.md",

@@ -98,10 +98,14 @@ def judge(pipeline: float, paper: float, op: str, tol: Tolerance) -> str:
     return "close" if abs(pipeline - paper) <= margin else "miss"
 
 
-def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame]) -> pd.DataFrame:
+def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
+             runs: pd.DataFrame | None = None) -> pd.DataFrame:
     """One row per target with the pipeline's value (in the paper's unit) and a status.
 
-    `metrics` maps experiment name -> its tidy metrics table (run_id, metric, value, unit, ...)."""
+    `metrics` maps experiment name -> its tidy metrics table (run_id, metric, value, unit, ...); `runs` (the
+    report's run list: experiment, run_id, status) lets a target whose run failed say why."""
+    failed = {} if runs is None or runs.empty else {
+        (r.experiment, r.run_id): r.status for r in runs.itertuples() if r.status != "ok"}
     rows = []
     for t in targets.itertuples(index=False):
         tol = Tolerance.parse(t.tolerance)
@@ -115,8 +119,10 @@ def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame])
                 found = table[(table["metric"] == t.metric) & (table["run_id"] == t.run)]
             if found.empty:
                 row["status"] = "miss"
-                row["note"] = "; ".join(x for x in (t.note, f"no pipeline value ({t.experiment}/{t.run}: {t.metric})")
-                                        if x)
+                why = failed.get((t.experiment, t.run))
+                why = f"run {t.experiment}/{t.run} {why}" if why else \
+                    f"no pipeline value ({t.experiment}/{t.run}: {t.metric})"
+                row["note"] = "; ".join(x for x in (t.note, why) if x)
             else:
                 value = convert(float(found["value"].iloc[0]), found["unit"].iloc[0], t.unit)
                 row["pipeline_value"] = value
