@@ -23,9 +23,11 @@ def test_pipeline_to_report(data_dir):
     for name in ("index.md", "index.html", "ur5-ik-fsm.md", "ur5-ik-fsm.html", "targets.csv"):
         assert (report / name).is_file(), name
     targets = pd.read_csv(report / "targets.csv")
-    assert list(targets.columns) == ["slug", "target_id", "quantity", "where", "paper_value", "pipeline_value",
-                                     "unit", "mode", "tolerance", "status"]
-    assert set(targets["status"]) <= {"match", "close", "miss", "not-reproducible"}
+    assert list(targets.columns) == ["slug", "target_id", "category", "quantity", "where", "paper_value", "op",
+                                     "pipeline_value", "deviation", "relative_deviation", "unit", "mode", "basis",
+                                     "tolerance", "status", "cause", "note", "experiment", "run"]
+    assert set(targets["status"]) <= {"match", "close", "consistent", "miss", "not run", "not-reproducible",
+                                      "agrees", "disagrees"}
     targets = targets[targets["slug"] == "ur5-ik-fsm"]   # other papers' targets have no runs here
     status = targets.set_index("target_id")["status"]
     tables = status[status.index.str.match(r"T[346]\.")]

@@ -38,7 +38,8 @@ def test_targets_files_are_valid_and_point_at_real_experiments(slug):
 
 def test_judge_rules():
     assert judge(1.00004, 1.0, "==", Tolerance(5e-5)) == "match"
-    assert judge(1.0004, 1.0, "==", Tolerance(5e-5)) == "close"
+    assert judge(1.00009, 1.0, "==", Tolerance(5e-5)) == "close"
+    assert judge(1.0004, 1.0, "==", Tolerance(5e-5)) == "miss"
     assert judge(1.01, 1.0, "==", Tolerance(5e-5)) == "miss"
     assert judge(-math.pi + 1e-6, math.pi, "==", Tolerance(5e-5, wrap=True)) == "match"
     assert judge(1.00005e7, 1e7, "==", Tolerance(1e-4, relative=True)) == "match"
@@ -88,7 +89,10 @@ def test_a_target_of_a_failed_run_says_why():
 
     targets = pd.DataFrame([{"target_id": "x", "category": "tracking errors", "quantity": "q", "where": "T1",
                              "value": "1", "unit": "m", "mode": "exact", "op": "==", "tolerance": "0.1",
+                             "basis": "simulation", "cause": "",
                              "experiment": "e", "run": "r", "metric": "m", "note": ""}])
     runs = pd.DataFrame([{"experiment": "e", "run_id": "r", "status": "failed: diverged at t = 1 s", "ok": False}])
     row = evaluate("s", targets, {"e": pd.DataFrame(columns=["run_id", "metric", "value", "unit"])}, runs).iloc[0]
-    assert row["status"] == "miss" and "failed: diverged at t = 1 s" in row["note"]
+    assert row["status"] == "miss" and "failed: diverged at t = 1 s" in row["note"] and row["cause"] == "open"
+    never_ran = evaluate("s", targets, {}, runs.assign(experiment="other")).iloc[0]
+    assert never_ran["status"] == "not run"

@@ -20,9 +20,12 @@ from markdown_it import MarkdownIt
 from analysis.core.targets import CATEGORIES, STATUSES
 from pipeline.core import provenance
 
-TARGETS_CSV_COLUMNS = ["slug", "target_id", "quantity", "where", "paper_value", "pipeline_value", "unit", "mode",
-                       "tolerance", "status"]
-STATUS_MARK = {"match": "✅ match", "close": "🟡 close", "miss": "❌ miss", "not-reproducible": "⚪ n.r."}
+TARGETS_CSV_COLUMNS = ["slug", "target_id", "category", "quantity", "where", "paper_value", "op", "pipeline_value",
+                       "deviation", "relative_deviation", "unit", "mode", "basis", "tolerance", "status", "cause",
+                       "note", "experiment", "run"]
+STATUS_MARK = {"match": "✅ match", "close": "🟡 close", "consistent": "🔵 consistent", "miss": "❌ miss",
+               "not run": "· not run", "not-reproducible": "⚪ n.r.", "agrees": "✅ agrees",
+               "disagrees": "❌ disagrees"}
 
 
 def _fmt(x) -> str:
@@ -78,7 +81,7 @@ def paper_page(info: dict, evaluated: pd.DataFrame, runs: pd.DataFrame, sections
             continue
         shown = part.assign(status=part["status"].map(STATUS_MARK))[
             ["target_id", "quantity", "where", "paper_value", "op", "pipeline_value", "unit", "mode", "tolerance",
-             "status", "note"]]
+             "status", "cause", "note"]]
         lines += [f"### {category.capitalize()}", "", _md_table(shown), ""]
     for section in sections:
         lines += [section.strip(), ""]
