@@ -36,6 +36,16 @@ def parse(argv: list[str]) -> dict[str, str | None]:
         hint = difflib.get_close_matches(args["experiment"], known, n=1)
         raise ValueError(f"unknown experiment '{args['experiment']}'"
                          + (f" (did you mean '{hint[0]}'?)" if hint else f"; one of {', '.join(known)}"))
+    from pipeline.core.checks import BadInput, check_data_dir
+
+    try:
+        data_dir = check_data_dir(args["data_dir"])
+    except BadInput as err:
+        raise ValueError(str(err)) from None
+    if not data_dir.is_dir():
+        raise ValueError(f"data_dir={args['data_dir']} does not exist: the simulate stage writes it "
+                         f"(python -m pipeline experiment={args['experiment'] or '<slug>/<name>'} "
+                         f"data_dir={args['data_dir']})")
     return args
 
 
@@ -46,8 +56,14 @@ def main() -> None:
         print(f"error: {err}", file=sys.stderr)
         sys.exit(2)
     from analysis.core.stages import run
+    from pipeline.core import interrupts
 
-    sys.exit(run(Path(args["data_dir"]), args["experiment"], args["stage"]))
+    interrupts.install()
+    try:
+        sys.exit(run(Path(args["data_dir"]), args["experiment"], args["stage"]))
+    except KeyboardInterrupt as err:  # every output is published whole, so nothing half-written is left
+        print("interrupted", file=sys.stderr)
+        sys.exit(interrupts.exit_code(err))
 
 
 if __name__ == "__main__":

@@ -12,6 +12,7 @@ spheres and cylinders of `/markers` (Foxglove SceneUpdate) drawn in the /tf fram
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -76,6 +77,7 @@ def convert(run_path: Path, out: Path | None = None, spawn: bool = False) -> Pat
     out = out or run_path.with_suffix(".rrd")
     rec = rr.RecordingStream(f"repro-{run.metadata.get('slug', 'run')}", recording_id=run.run_id)
     if spawn:
+        os.environ.setdefault("CI", "1")  # the viewer sends no usage analytics where CI is set (re_analytics)
         rec.spawn()
     rec.save(out)
     rec.log("run", rr.TextDocument("\n".join(f"{k}: {v}" for k, v in run.metadata.items())), static=True)

@@ -31,17 +31,36 @@ def main() -> None:
     from hydra.core.hydra_config import HydraConfig
     from omegaconf import DictConfig
 
+    from pipeline.core import interrupts
     from pipeline.core.experiment import CONF_DIR
     from pipeline.core.runner import simulate
 
+    stage_pid = os.getpid()
+
     @hydra.main(config_path=str(CONF_DIR), config_name="config", version_base=None)
     def task(cfg: DictConfig) -> None:
+        worker = os.getpid() != stage_pid
+        if worker:  # a sweep worker must not outlive the stage that started it
+            interrupts.die_with_parent()
         hc = HydraConfig.get()
-        errors = simulate(cfg, hc.runtime.choices["experiment"], list(hc.overrides.task))
+        try:
+            errors = simulate(cfg, hc.runtime.choices["experiment"], list(hc.overrides.task))
+        except BadInput as err:
+            print(f"error: {err}", file=sys.stderr)
+            raise SystemExit(2) from None
+        except KeyboardInterrupt as err:
+            if worker:  # the open run is already dropped; a worker pool would start the next job
+                os._exit(interrupts.exit_code(err))
+            raise
         if errors:
             raise SystemExit(1)
 
-    task()
+    interrupts.install()
+    try:
+        task()
+    except KeyboardInterrupt as err:  # Ctrl-C or SIGTERM: the open run was dropped, finished ones stay
+        print("interrupted: the run in progress was dropped; finished runs are kept", file=sys.stderr)
+        sys.exit(interrupts.exit_code(err))
 
 
 if __name__ == "__main__":

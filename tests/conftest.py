@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-ENV = {**os.environ, "RERUN_ANALYTICS": "0", "PYTHONHASHSEED": "0"}
+# CI set: Rerun's tools send no usage analytics (its only switch that leaves the user's config alone)
+ENV = {**os.environ, "CI": "1", "PYTHONHASHSEED": "0"}
 
 
 def run_cli(module: str, *args: str, timeout: float = 300) -> subprocess.CompletedProcess:

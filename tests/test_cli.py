@@ -18,7 +18,7 @@ SHORT_PATH = ["scenario.paths=[wrist]", "scenario.crossings=[near]", "scenario.d
 @pytest.mark.parametrize(("args", "names"), [
     (["experiment=ur5-ik-fsm/tabels"], "unknown experiment 'ur5-ik-fsm/tabels'"),
     (["experiment=ur5-ik-fsm/tables", "scenario.tabel2=1"], "unknown config key 'scenario.tabel2'"),
-    (["experiment=ur5-ik-fsm/singular-paths", "execute.dt=0"], "execute.dt=0 is out of range: must be > 0"),
+    (["experiment=ur5-ik-fsm/singular-paths", "execute.dt=0"], "execute.dt=0 is out of range: must be >= 0.0001"),
     (["experiment=ur5-ik-fsm/singular-paths", "execute.dt=-0.001"], "execute.dt=-0.001 is out of range"),
     (["experiment=ur5-ik-fsm/tables", "system.geometry.a2=nan"], "system.geometry.a2=nan is not a finite number"),
     (["experiment=ur5-ik-fsm/tables", "system.geometry.d4=x"], "system.geometry.d4='x' must be a number"),
@@ -68,7 +68,8 @@ def test_ray_launcher_config_composes():
 def test_divergence_is_a_failed_run_and_the_stage_goes_on(data_dir):
     # a 20 ms step under a 200 Hz servo with no torque limit blows up
     proc = run_cli("pipeline", "experiment=ur5-ik-fsm/singular-paths", *SHORT_PATH, "execute.dt=0.02",
-                   "execute.bandwidth_hz=200", "system.dynamics.torque_limit=[1e9,1e9,1e9,1e9,1e9,1e9]",
+                   "scenario.ik_dt=0.02", "execute.log_dt=0.02", "execute.bandwidth_hz=100",
+                   "system.dynamics.torque_limit=[1e9,1e9,1e9,1e9,1e9,1e9]",
                    f"data_dir={data_dir}")
     assert proc.returncode == 0
     runs = [read_run(p) for p in run_files(data_dir / "runs/ur5-ik-fsm/singular-paths")]
@@ -93,10 +94,10 @@ def test_choice_parameters_are_checked():
     from omegaconf import OmegaConf
 
     from pipeline.core.checks import BadInput, check_config
-    from pipeline.core.experiment import OneOf
+    from pipeline.core.experiment import Length, OneOf
 
     defaults = OmegaConf.create({"mode": "x", "joints": ["p", "q"]})
-    limits = {"mode": OneOf(("x", "y")), "joints": OneOf(("p", "q"))}
+    limits = {"mode": OneOf(("x", "y")), "joints": (Length(1, 2), OneOf(("p", "q")))}
     check_config(OmegaConf.create({"mode": "y", "joints": ["q"]}), defaults, limits)
     with pytest.raises(BadInput, match=r"mode='z' is not allowed: must be one of x, y"):
         check_config(OmegaConf.create({"mode": "z", "joints": ["p"]}), defaults, limits)

@@ -48,5 +48,6 @@ def test_pipeline_to_report(data_dir):
 
 
 def test_analysis_of_missing_runs_says_what_to_do(data_dir):
+    data_dir.mkdir()
     proc = run_cli("analysis", "experiment=ur5-ik-fsm/tables", f"data_dir={data_dir}")
     assert proc.returncode == 1 and "python -m pipeline experiment=ur5-ik-fsm/tables" in proc.stderr

@@ -274,7 +274,7 @@ def test_slider_and_compute_time_end_to_end(data_dir):
 
 
 @pytest.mark.parametrize(("override", "says"), [
-    ("scenario.links=11", "out of range"), ("system.links.mass=[0,1,1,1,1,1,1,1,1,1]", "out of range"),
+    ("scenario.links=[1,11]", "out of range"), ("system.links.mass=[0,1,1,1,1,1,1,1,1,1]", "out of range"),
     ("system.simulation.integrator=euler", "must be one of semi-implicit-euler, rk4"),
 ])
 def test_bad_input_is_refused(override, says):

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import matplotlib
 
+from pipeline.core.files import atomic_path
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
@@ -31,9 +33,9 @@ class Figures:
     def save(self, fig, name: str) -> Path:
         png = self.directory / f"{name}.png"
         fig.tight_layout()
-        fig.savefig(png)
-        if SVG:
-            fig.savefig(png.with_suffix(".svg"))
+        for path in (png, png.with_suffix(".svg")) if SVG else (png,):
+            with atomic_path(path) as tmp:
+                fig.savefig(tmp, format=path.suffix[1:])
         plt.close(fig)
         self.saved.append(png)
         return png

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from pipeline.core.files import atomic_path
 from pipeline.core.runlog import Run
 
 COLUMNS = ["run_id", "metric", "value", "unit"]
@@ -36,10 +37,8 @@ def metric_value(frame: pd.DataFrame, run_id: str, metric: str) -> float:
 
 
 def write_metrics(frame: pd.DataFrame, path: Path) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.partial")
-    frame.to_parquet(tmp, index=False)
-    tmp.replace(path)
+    with atomic_path(path) as tmp:
+        frame.to_parquet(tmp, index=False)
 
 
 def read_metrics(paths: Iterable[Path]) -> dict[str, pd.DataFrame]:

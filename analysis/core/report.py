@@ -18,7 +18,7 @@ import yaml
 from markdown_it import MarkdownIt
 
 from analysis.core.targets import CATEGORIES, STATUSES
-from pipeline.core import provenance
+from pipeline.core import files, provenance
 
 TARGETS_CSV_COLUMNS = ["slug", "target_id", "category", "quantity", "where", "paper_value", "op", "pipeline_value",
                        "deviation", "relative_deviation", "unit", "mode", "basis", "tolerance", "status", "cause",
@@ -134,9 +134,8 @@ def to_html(markdown: str, title: str) -> str:
 
 
 def write_page(path: Path, markdown: str, title: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(markdown + "\n")
-    path.with_suffix(".html").write_text(to_html(markdown, title))
+    files.write_text(path, markdown + "\n")
+    files.write_text(path.with_suffix(".html"), to_html(markdown, title))
 
 
 def load_paper_info(package_dir: Path) -> dict:
@@ -146,5 +145,5 @@ def load_paper_info(package_dir: Path) -> dict:
 def write_targets_csv(evaluated: list[pd.DataFrame], path: Path) -> pd.DataFrame:
     frame = pd.concat(evaluated, ignore_index=True) if evaluated else pd.DataFrame(columns=TARGETS_CSV_COLUMNS)
     frame = frame[TARGETS_CSV_COLUMNS]
-    frame.to_csv(path, index=False)
+    files.write_text(path, frame.to_csv(index=False))
     return frame

@@ -20,8 +20,9 @@ from analysis.core import report
 from analysis.core.figures import Figures
 from analysis.core.metrics import read_metrics, write_metrics
 from analysis.core.targets import evaluate, load_targets
+from pipeline.core import files
 from pipeline.core.experiment import available_experiments, module_name
-from pipeline.core.runlog import read_run, run_files
+from pipeline.core.runlog import Run, read_run, run_files
 
 PAPERS_DIR = Path(__file__).resolve().parents[1] / "papers"
 
@@ -35,23 +36,39 @@ def analyzed_slugs() -> list[str]:
     return sorted(p.parent.name.replace("_", "-") for p in PAPERS_DIR.glob("*/paper.yaml"))
 
 
+def _read(path: Path, slug: str, name: str) -> tuple[Run | None, dict]:
+    """A run file and its row of the run list; a damaged file or another experiment's run is listed with the
+    reason and left out of the analysis (the rest is analysed)."""
+    try:
+        run = read_run(path).verify()
+    except Exception as err:  # truncated, byte-flipped, empty, not MCAP at all
+        reason = str(err).splitlines()[0] if str(err) else type(err).__name__
+        return None, {"run_id": path.stem, "status": f"unreadable: {reason}"[:200], "ok": False}
+    row = {"run_id": run.run_id, "status": run.status, "ok": run.ok,
+           "wall_time_s": float(run.metadata.get("wall_time_s", "nan")),
+           "machine": run.metadata.get("machine", "{}"), **run.params}
+    where = (run.metadata.get("slug"), run.metadata.get("experiment"))
+    if where != (slug, name):
+        return None, {**row, "run_id": path.stem, "status": f"foreign: a run of {where[0]}/{where[1]}", "ok": False}
+    return run, row
+
+
 def analyze(experiment_id: str, data_dir: Path) -> Path | None:
     """Runs on disk -> metrics parquet, run list and figures. None if there are no runs."""
     slug, _, name = experiment_id.partition("/")
-    files = run_files(data_dir / "runs" / slug / name)
-    if not files:
+    paths = run_files(data_dir / "runs" / slug / name)
+    if not paths:
         return None
-    runs = [read_run(p) for p in files]
-    run_list = pd.DataFrame([{"run_id": r.run_id, "status": r.status, "ok": r.ok,
-                              "wall_time_s": float(r.metadata.get("wall_time_s", "nan")),
-                              "machine": r.metadata.get("machine", "{}"), **r.params} for r in runs])
+    read = [_read(p, slug, name) for p in paths]
+    run_list = pd.DataFrame([row for _, row in read])
+    runs = [run for run, _ in read if run is not None]
     ok = [r for r in runs if r.ok]
     figures = Figures(data_dir / "figures" / slug / name)
     analysis = paper_package(slug).ANALYSES[name]
     metrics = analysis(ok, figures) if ok else pd.DataFrame(columns=["run_id", "metric", "value", "unit"])
     out = data_dir / "metrics" / slug / f"{name}.parquet"
     write_metrics(metrics, out)
-    run_list.to_csv(out.with_suffix(".runs.csv"), index=False)
+    files.write_text(out.with_suffix(".runs.csv"), run_list.to_csv(index=False))
     return out
 
 
@@ -87,18 +104,37 @@ def write_report(data_dir: Path) -> Path:
 
 
 def run(data_dir: Path, experiment: str | None, stage: str) -> int:
+    """Analyze the experiments that have runs, then write the report; 1 if nothing could be analysed or an
+    experiment's analysis failed (the others are still analysed)."""
     experiments = [experiment] if experiment else [e for e in available_experiments()
                                                    if e.split("/")[0] in analyzed_slugs()]
+    failed = 0
     if stage in ("analyze", "all"):
+        analysed = 0
         for experiment_id in experiments:
-            out = analyze(experiment_id, data_dir)
+            try:
+                out = analyze(experiment_id, data_dir)
+            except Exception as err:  # a bug in one paper's analysis: say so, analyse the others
+                failed += 1
+                print(f"error: the analysis of {experiment_id} failed: {type(err).__name__}: "
+                      f"{str(err).splitlines()[0] if str(err) else ''}"[:280], file=sys.stderr)
+                continue
             if out is None:
-                print(f"{experiment_id}: no runs under {data_dir / 'runs' / experiment_id}; "
-                      f"run: python -m pipeline experiment={experiment_id}", file=sys.stderr)
                 if experiment:
+                    print(f"error: no runs under {data_dir / 'runs' / experiment_id}; "
+                          f"run: python -m pipeline experiment={experiment_id} data_dir={data_dir}", file=sys.stderr)
                     return 1
             else:
+                analysed += 1
                 print(f"wrote {out}", file=sys.stderr)
+        if not analysed and not failed:
+            print(f"error: no runs under {data_dir / 'runs'}: run an experiment first, e.g. "
+                  f"python -m pipeline experiment={experiments[0]} data_dir={data_dir}", file=sys.stderr)
+            return 1
     if stage in ("report", "all"):
+        if not any((data_dir / "metrics").glob("*/*.parquet")):
+            print(f"error: no metrics under {data_dir / 'metrics'}: python -m analysis data_dir={data_dir} "
+                  "analyses the runs first", file=sys.stderr)
+            return 1
         print(f"wrote {write_report(data_dir)}", file=sys.stderr)
-    return 0
+    return 1 if failed else 0

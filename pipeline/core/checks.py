@@ -1,8 +1,11 @@
 """Bad input is refused before anything runs, with one line that names the key and what is allowed.
 
-`preflight(argv)` composes the config exactly as Hydra will (each swept value once), then checks it:
-unknown experiment or key, a value whose type differs from its default, NaN/inf, and out-of-range physical
-parameters (`POSITIVE_NAMES` everywhere, plus the paper's own `LIMITS`).
+`preflight(argv)` composes the config exactly as Hydra will (each swept value once), then checks it against
+what the experiment declares (pipeline.core.experiment): the shape of every value (a list stays a list of the
+default's length unless its LIMITS entry is a `Length`; a single value stays single), its type, NaN/inf, its
+range or choices (the paper's LIMITS, then NAMED_LIMITS), the RULES between parameters, the experiment's
+cost BUDGET, the cases it makes (at least one, at most MAX_CASES, names that are safe file names), and the
+data_dir every output goes under.
 """
 
 from __future__ import annotations
@@ -10,18 +13,36 @@ from __future__ import annotations
 import difflib
 import importlib.util
 import math
+import os
+import re
+import tempfile
 from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
 from hydra import compose, initialize_config_dir
 from hydra.core.global_hydra import GlobalHydra
 from hydra.core.override_parser.overrides_parser import OverridesParser
-from omegaconf import DictConfig, ListConfig
+from omegaconf import DictConfig, ListConfig, OmegaConf
 
-from pipeline.core.experiment import CONF_DIR, POSITIVE, POSITIVE_NAMES, OneOf, Range, available_experiments, resolve
+from pipeline.core.experiment import (
+    CONF_DIR,
+    MAX_CASES,
+    NAMED_LIMITS,
+    Case,
+    Experiment,
+    Length,
+    Limit,
+    OneOf,
+    Range,
+    Text,
+    available_experiments,
+    resolve,
+)
 
 NO_PREFLIGHT_FLAGS = {"--help", "-h", "--hydra-help", "--info", "-i", "--shell-completion", "-sc"}
 SWEEP_LIMIT = 10_000
+SAFE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._=,+-]{0,199}")
 
 
 class BadInput(ValueError):
@@ -43,29 +64,150 @@ def _is_number(x: Any) -> bool:
     return isinstance(x, int | float) and not isinstance(x, bool)
 
 
-def check_config(cfg: DictConfig, defaults: DictConfig, limits: dict[str, Range | OneOf]) -> None:
-    """Raise BadInput for the first value that is not a finite number where a number belongs, has the
-    wrong type, lies outside its range, or is not one of a choice's values."""
-    default_values = dict(_leaves(defaults))
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def declared(limits: dict[str, Limit | tuple[Limit, ...]], key: str) -> tuple[Limit, ...]:
+    """The limits declared for a key (a list's elements share their list's entry; `Text` on a key covers
+    everything under it: a table of the paper's data)."""
+    plain = re.sub(r"\[\d+\]", "", key)
+    found = limits.get(plain)
+    if found is None:
+        parts = plain.split(".")
+        if any(isinstance(limits.get(".".join(parts[:i])), Text) for i in range(1, len(parts))):
+            return (Text(),)
+        named = NAMED_LIMITS.get(parts[-1])
+        return (named,) if named else ()
+    return found if isinstance(found, tuple) else (found,)
+
+
+def _of(kind: type, limits: tuple[Limit, ...]) -> Any:
+    return next((x for x in limits if isinstance(x, kind)), None)
+
+
+def _check_shape(value: Any, default: Any, key: str, limits: dict) -> None:
+    """A list stays a list (of its default's length, unless declared `Length`), a single value single."""
+    if isinstance(default, DictConfig):
+        for k in default:
+            if k in value and not (not key and k == "hydra"):
+                _check_shape(value._get_node(k), default._get_node(k), f"{key}.{k}" if key else str(k), limits)
+        return
+    if isinstance(default, ListConfig):
+        if not isinstance(value, ListConfig):
+            shown = OmegaConf.to_object(value) if isinstance(value, DictConfig) else value._value()
+            raise BadInput(f"{key}={_short(shown)} must be a list, e.g. {key}=[{shown}] "
+                           f"(default {_short(OmegaConf.to_object(default))})")
+        length = _of(Length, declared(limits, key))
+        if length is not None and len(value) not in length:
+            raise BadInput(f"{key} has {len(value)} elements: must be {length}")
+        if length is None and len(value) != len(default):
+            raise BadInput(f"{key} has {len(value)} elements: must have {len(default)}, like its default "
+                           f"{_short(OmegaConf.to_object(default))}")
+        if len(default):
+            for i in range(len(value)):
+                _check_shape(value._get_node(i), default._get_node(min(i, len(default) - 1)), f"{key}[{i}]", limits)
+        return
+    if isinstance(value, ListConfig | DictConfig):
+        raise BadInput(f"{key}={_short(OmegaConf.to_object(value))} must be a single value like "
+                       f"{_short(default._value())}")
+    if _of(Text, declared(limits, key)) is None:  # free text may stand where a number is (`pi/2`)
+        _check_type(value._value(), default._value(), key)
+
+
+def _check_type(value: Any, default: Any, key: str) -> None:
+    if default is None:
+        return
+    if isinstance(default, bool):
+        if not isinstance(value, bool):
+            raise BadInput(f"{key}={_short(value)} must be true or false")
+    elif _is_number(default):
+        if not _is_number(value):
+            raise BadInput(f"{key}={_short(value)} must be a number (default {default})")
+    elif isinstance(default, str) and not isinstance(value, str):
+        raise BadInput(f"{key}={_short(value)} must be a string like {default!r}")
+
+
+def check_config(cfg: DictConfig, defaults: DictConfig, limits: dict[str, Limit | tuple[Limit, ...]]) -> None:
+    """Raise BadInput for the first value whose shape or type differs from its default's, that is not a
+    finite number where a number belongs, lies outside its range, or is not one of its choices."""
+    _check_shape(cfg, defaults, "", limits)
     for key, value in _leaves(cfg):
-        if key.startswith("hydra."):
+        if key.startswith("hydra.") or key in ("data_dir",):
             continue
-        choice = limits.get(key.split("[")[0])
-        if isinstance(choice, OneOf) and value not in choice:
-            raise BadInput(f"{key}={value!r} is not allowed: must be {choice}")
-        default = default_values.get(key)
-        if _is_number(default) and not _is_number(value):
-            raise BadInput(f"{key}={value!r} must be a number (default {default})")
-        if isinstance(default, bool) and not isinstance(value, bool):
-            raise BadInput(f"{key}={value!r} must be true or false")
+        allowed = declared(limits, key)
+        choice, text, interval = _of(OneOf, allowed), _of(Text, allowed), _of(Range, allowed)
+        if choice is not None and value not in choice:
+            hint = difflib.get_close_matches(str(value), choice.values, n=1)
+            raise BadInput(f"{key}={_short(value)} is not allowed: must be {choice}"
+                           + (f" (did you mean '{hint[0]}'?)" if hint else ""))
+        if text is not None and isinstance(value, str) and len(value) > text.max_chars:
+            raise BadInput(f"{key} is {len(value)} characters long: at most {text.max_chars}")
         if not _is_number(value):
             continue
         if not math.isfinite(value):
             raise BadInput(f"{key}={value} is not a finite number")
-        base = key.split("[")[0]
-        allowed = limits.get(base) or (POSITIVE if base.rsplit(".", 1)[-1] in POSITIVE_NAMES else None)
-        if allowed is not None and value not in allowed:
-            raise BadInput(f"{key}={value:g} is out of range: must be {allowed}")
+        if interval is not None and value not in interval:
+            raise BadInput(f"{key}={value:g} is out of range: must be {interval}")
+
+
+def _select(cfg: DictConfig, key: str) -> Any:
+    value = OmegaConf.select(cfg, key, throw_on_missing=False)
+    return OmegaConf.to_object(value) if isinstance(value, DictConfig | ListConfig) else value
+
+
+def check_rules(cfg: DictConfig, experiment: Experiment) -> None:
+    """The constraints between parameters, then the cost estimate."""
+    for rule in experiment.rules:
+        values = [_select(cfg, k) for k in rule.keys]
+        if any(v is None for v in values):
+            continue
+        if not rule.holds(*values):
+            raise BadInput(rule.message.format(*values))
+    budget = experiment.budget
+    if budget is not None:
+        cost = budget.estimate(cfg)
+        if not cost <= budget.limit:
+            raise BadInput(f"{experiment.id} would need about {cost:.3g} {budget.what}, more than the budget of "
+                           f"{budget.limit:.3g}" + (f": {budget.hint}" if budget.hint else ""))
+
+
+def check_cases(cfg: DictConfig, experiment: Experiment) -> list[Case]:
+    """The experiment's cases for this config: at least one, at most MAX_CASES, unique safe names."""
+    try:
+        cases = experiment.fn(cfg)
+    except (ValueError, KeyError, TypeError, IndexError) as err:
+        raise BadInput(f"{experiment.id}: {str(err).splitlines()[0] if str(err) else type(err).__name__}") from None
+    if not cases:
+        raise BadInput(f"{experiment.id} makes no run with this config: check the lists in `scenario`")
+    if len(cases) > MAX_CASES:
+        raise BadInput(f"{experiment.id} would make {len(cases)} runs in one process, more than {MAX_CASES}: "
+                       "split it with a sweep (-m)")
+    ids = [case.id for case in cases]
+    for case_id in ids:
+        if not SAFE_NAME.fullmatch(case_id):
+            raise BadInput(f"{experiment.id}: run name {_short(case_id)} is not a safe file name "
+                           "(letters, digits and ._=,+- only, 200 at most)")
+    dupes = sorted({i for i in ids if ids.count(i) > 1})
+    if dupes:
+        raise BadInput(f"{experiment.id}: the config names two runs {dupes[0]!r}: list each case once")
+    return cases
+
+
+def check_data_dir(value: Any) -> Path:
+    """Where every output goes: a directory this process can create or write."""
+    if value is None or not str(value).strip():
+        raise BadInput("data_dir is empty: give a directory, e.g. data_dir=data")
+    path = Path(str(value)).expanduser()
+    if path.exists() and not path.is_dir():
+        raise BadInput(f"data_dir={value} is a file, not a directory")
+    existing = next(p for p in (path.absolute(), *path.absolute().parents) if p.exists())
+    try:  # a real probe: permission bits say nothing to root, or on /proc and read-only mounts
+        os.rmdir(tempfile.mkdtemp(dir=existing, prefix=".probe-"))
+    except OSError:
+        raise BadInput(f"data_dir={value} cannot be written ({existing} is not a writable directory)") from None
+    return path
 
 
 def _variants(overrides: list[str]) -> list[tuple[str | None, list[str]]]:
@@ -106,7 +248,11 @@ def _one_line(err: Exception, overrides: list[str], valid_keys: list[str]) -> st
         return f"unknown config key '{key}'" + (f" (did you mean '{hint[0]}'?)" if hint else "")
     if "Could not find" in text or "Could not load" in text:
         return text.splitlines()[0]
-    return f"{text.splitlines()[0]} ({' '.join(overrides)})"
+    return f"{text.splitlines()[0]} ({' '.join(overrides)})"[:280]
+
+
+def _listing(known: list[str]) -> str:
+    return f"{len(known)} exist, e.g. {', '.join(known[:2])} (all: ls conf/experiment/*)"
 
 
 def compose_config(overrides: list[str]) -> DictConfig:
@@ -129,28 +275,31 @@ def preflight(argv: list[str]) -> None:
         raise BadInput(f"cannot parse the overrides: {str(err).splitlines()[0]}") from None
 
     known = available_experiments()
-    checked_defaults: dict[str, tuple[DictConfig, list[str], dict]] = {}
-    for experiment, extra in variants:
-        if experiment is None:
-            raise BadInput("choose an experiment: experiment=<slug>/<name>, one of " + ", ".join(known))
-        if experiment not in known:
-            hint = difflib.get_close_matches(experiment, known, n=1)
-            raise BadInput(f"unknown experiment '{experiment}'"
-                           + (f" (did you mean '{hint[0]}'?)" if hint else f"; one of {', '.join(known)}"))
+    checked: dict[str, tuple[DictConfig, list[str], Experiment]] = {}
+    for experiment_id, extra in variants:
+        if experiment_id is None:
+            raise BadInput(f"choose an experiment: experiment=<slug>/<name>; {_listing(known)}")
+        if experiment_id not in known:
+            hint = difflib.get_close_matches(experiment_id, known, n=1)
+            raise BadInput(f"unknown experiment '{experiment_id}'"
+                           + (f" (did you mean '{hint[0]}'?)" if hint else f"; {_listing(known)}"))
         if any(o.replace(" ", "") == "hydra/launcher=ray" for o in extra) and \
                 importlib.util.find_spec("hydra_plugins.hydra_ray_launcher") is None:
             raise BadInput("hydra/launcher=ray needs the Ray launcher: pip install -e '.[ray]'")
         for o in extra:
             if o.startswith("+") and not o.startswith("+hydra"):
                 raise BadInput(f"adding keys is not allowed ('{o}'): every parameter has a default in conf/")
-        if experiment not in checked_defaults:
-            defaults = compose_config([f"experiment={experiment}"])
-            checked_defaults[experiment] = (defaults, [k for k, _ in _leaves(defaults)], resolve(experiment)[3])
-        defaults, valid_keys, limits = checked_defaults[experiment]
-        job_overrides = [f"experiment={experiment}", *(o for o in extra if not o.lstrip("+~").startswith("hydra"))]
+        if experiment_id not in checked:
+            defaults = compose_config([f"experiment={experiment_id}"])
+            checked[experiment_id] = (defaults, [k for k, _ in _leaves(defaults)], resolve(experiment_id))
+        defaults, valid_keys, experiment = checked[experiment_id]
+        job_overrides = [f"experiment={experiment_id}", *(o for o in extra if not o.lstrip("+~").startswith("hydra"))]
         try:
             cfg = compose_config(job_overrides)
         except Exception as err:
             raise BadInput(_one_line(err, job_overrides, valid_keys)) from None
-        check_config(cfg, defaults, limits)
+        check_data_dir(cfg.data_dir)
+        check_config(cfg, defaults, experiment.limits)
+        check_rules(cfg, experiment)
+        check_cases(cfg, experiment)
     GlobalHydra.instance().clear()

@@ -3,9 +3,14 @@
 A paper package `pipeline.papers.<slug with _>` exports
 
     EXPERIMENTS: dict[str, Callable[[DictConfig], list[Case]]]   # one entry per conf/experiment/<slug>/<name>.yaml
-    LIMITS: dict[str, Range | OneOf]                             # physical ranges / allowed choices (optional)
+    LIMITS: dict[str, Limit | tuple[Limit, ...]]   # per dotted key: ranges, choices, list lengths, free text
+    RULES: list[Rule]                              # constraints between parameters (optional)
+    BUDGETS: dict[str, Budget]                     # experiment name -> cost estimate and its limit (optional)
 
-An experiment turns its resolved config into cases; each case is one run, one MCAP file.
+An experiment turns its resolved config into cases; each case is one run, one MCAP file. Everything declared
+here is checked before anything runs (pipeline.core.checks): the declarations sit beside the experiments
+they guard, and tests/test_reliability.py checks that every choice, size, count, duration and time step of
+every experiment is covered.
 """
 
 from __future__ import annotations
@@ -13,7 +18,7 @@ from __future__ import annotations
 import importlib
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING
@@ -69,13 +74,79 @@ class OneOf:
         return "one of " + ", ".join(self.values)
 
 
+@dataclass(frozen=True)
+class Length:
+    """A list that may hold another number of elements than its default (which it must keep otherwise)."""
+
+    min: int = 1
+    max: int = 100
+
+    def __contains__(self, n: int) -> bool:
+        return self.min <= n <= self.max
+
+    def __str__(self) -> str:
+        return f"a list of {self.min} to {self.max} elements"
+
+
+@dataclass(frozen=True)
+class Text:
+    """A free string (a label or a name) rather than a choice."""
+
+    max_chars: int = 200
+
+
+Limit = Range | OneOf | Length | Text
+
+
+@dataclass(frozen=True)
+class Rule:
+    """A constraint between parameters, checked before anything runs.
+
+    `holds` gets the values of `keys` in order; `message` says what must hold, formatted with those values
+    as {0}, {1}, … A rule whose keys are not all in an experiment's config does not apply to it."""
+
+    keys: tuple[str, ...]
+    holds: Callable[..., bool]
+    message: str
+
+
+@dataclass(frozen=True)
+class Budget:
+    """A preflight cost estimate: a config whose work exceeds `limit` is refused (sizes multiply, so
+    bounding each parameter alone does not bound a run)."""
+
+    what: str                                  # the unit of work: "simulation steps", "IK calls", …
+    estimate: Callable[[DictConfig], float]
+    limit: float
+    hint: str = ""                             # which keys to lower
+
+
+@dataclass(frozen=True)
+class Experiment:
+    slug: str
+    name: str
+    fn: ExperimentFn
+    limits: dict[str, Limit | tuple[Limit, ...]] = field(default_factory=dict)
+    rules: tuple[Rule, ...] = ()
+    budget: Budget | None = None
+
+    @property
+    def id(self) -> str:
+        return f"{self.slug}/{self.name}"
+
+
 POSITIVE = Range(gt=0)
 NON_NEGATIVE = Range(ge=0)
 PROBABILITY = Range(ge=0, le=1)
 ANGLE = Range(ge=-2 * math.pi, le=2 * math.pi)
 
-# Parameters named like this must be > 0 in every paper (the last key segment is matched).
-POSITIVE_NAMES = ("dt", "duration", "mass", "masses", "inertia", "rate_hz", "repeats", "samples")
+# Bounds every paper shares, by the last segment of a key; a paper's LIMITS entry for the key replaces them.
+NAMED_LIMITS: dict[str, Range] = {
+    **dict.fromkeys(("dt", "mass", "masses", "inertia", "rate_hz"), POSITIVE),
+    "duration": Range(gt=0, le=3600), "repeats": Range(ge=1, le=100_000), "samples": Range(ge=1, le=1_000_000),
+    "log_dt": Range(ge=1e-4, le=10), "tf_dt": Range(ge=1e-4, le=10),
+}
+MAX_CASES = 1000  # runs one experiment may make in one process
 
 
 def module_name(slug: str) -> str:
@@ -92,12 +163,13 @@ def available_experiments() -> list[str]:
     return sorted(str(p.relative_to(root).with_suffix("")) for p in root.glob("*/*.yaml"))
 
 
-def resolve(experiment_id: str) -> tuple[str, str, ExperimentFn, dict[str, Range | OneOf]]:
-    """`<slug>/<name>` -> (slug, name, experiment function, parameter limits)."""
+def resolve(experiment_id: str) -> Experiment:
+    """`<slug>/<name>` -> the experiment function and everything declared to check its config."""
     slug, _, name = experiment_id.partition("/")
     module = paper_module(slug)
     try:
         fn = module.EXPERIMENTS[name]
     except KeyError:
         raise KeyError(f"pipeline.papers.{module_name(slug)} has no experiment '{name}'") from None
-    return slug, name, fn, getattr(module, "LIMITS", {})
+    return Experiment(slug, name, fn, getattr(module, "LIMITS", {}), tuple(getattr(module, "RULES", ())),
+                      getattr(module, "BUDGETS", {}).get(name))

@@ -1,15 +1,15 @@
 """One run = one MCAP file: writing it safely and reading it back as pandas DataFrames.
 
 Log time is simulated time in nanoseconds from 0, so two runs of the same config are byte-comparable
-message by message. A run is written to a hidden `.partial` name and renamed only when complete: a killed
-run never leaves a file that looks finished, and a re-run replaces the old file atomically.
+message by message. A run is written under a unique hidden `.partial` name and renamed only when complete
+(pipeline.core.files): a killed run never leaves a file that looks finished, and a re-run replaces the old
+file atomically.
 """
 
 from __future__ import annotations
 
 import functools
 import json
-import os
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -23,21 +23,42 @@ from google.protobuf import descriptor_pb2
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 from mcap.reader import make_reader
+from mcap.records import Chunk
+from mcap.stream_reader import ReadDataStream, get_chunk_data_stream
 from mcap_protobuf.decoder import DecoderFactory
 
-from pipeline.core import schemas
+from pipeline.core import files, schemas
 from pipeline.core.encoding import encode_series
 from pipeline.robotics.transforms import quaternion_wxyz
 
 RUN_SUFFIX = ".mcap"
-PARTIAL_SUFFIX = ".mcap.partial"
 METADATA_NAME = "run"
 CONFIG_ATTACHMENT = "config.yaml"
 CHUNK_BYTES = 1024 * 1024
+# Topics that carry the simulated state: a NaN or an infinity there means the simulation diverged, and the
+# run fails with the first time it happened (every paper gets this watchdog by logging these topics).
+STATE_TOPICS = ("/joint_state", "/tracking_error", "/wrench", "/command")
 
 
 class SimulationFailed(RuntimeError):
     """A run that cannot go on (divergence, NaN, solver breakdown); recorded as `failed: <reason>`."""
+
+
+def _is_state(topic: str) -> bool:
+    return any(topic == t or topic.startswith(t + "/") for t in STATE_TOPICS)
+
+
+def _watch(topic: str, times: np.ndarray, columns: Mapping[str, Any]) -> None:
+    """Raise SimulationFailed at the first non-finite number of a state topic."""
+    for field_name, values in columns.items():
+        try:
+            array = np.asarray(values, dtype=float)
+        except (TypeError, ValueError):
+            continue  # names, strings
+        bad = ~np.isfinite(array)
+        if bad.any():
+            first = int(np.argmax(bad.reshape(len(times), -1).any(axis=1))) if array.ndim and len(times) > 1 else 0
+            raise SimulationFailed(f"diverged: non-finite {topic} {field_name} at t = {float(times[first]):.6g} s")
 
 
 def seconds_to_ns(t: float | np.ndarray) -> int | np.ndarray:
@@ -72,8 +93,7 @@ class RunWriter:
 
     def __init__(self, path: Path, metadata: Mapping[str, Any]):
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._partial = self.path.with_name(f".{self.path.stem}{PARTIAL_SUFFIX}")
+        self._partial = files.temporary_name(self.path)
         self._context = foxglove.Context()
         self._writer = foxglove.open_mcap(
             self._partial, allow_overwrite=True, context=self._context,
@@ -111,6 +131,8 @@ class RunWriter:
     def log(self, topic: str, t: float, message_type: type[Message] | None = None, **fields: Any) -> None:
         """Write one record at simulated time `t` (s); common topics know their schema."""
         cls = message_type or self._schema(topic)
+        if _is_state(topic):
+            _watch(topic, np.array([t]), {k: v for k, v in fields.items() if not isinstance(v, str)})
         self.write(topic, seconds_to_ns(t), cls(**fields))
 
     def log_series(self, topic: str, times: np.ndarray, message_type: type[Message] | None = None,
@@ -125,6 +147,8 @@ class RunWriter:
         for k, v in per_sample.items():
             if len(v) != len(times_ns):
                 raise ValueError(f"{topic}: column {k} has {len(v)} samples for {len(times_ns)} times")
+        if _is_state(topic):
+            _watch(topic, np.asarray(times, dtype=float), per_sample)
         encoded = encode_series(cls, constant, per_sample)
         if encoded is None:
             rows = {k: v.tolist() for k, v in per_sample.items()}
@@ -159,6 +183,11 @@ class RunWriter:
         self._writer.attach(log_time=0, create_time=0, name=name, media_type=media_type,
                             data=data.encode() if isinstance(data, str) else data)
 
+    @property
+    def messages(self) -> int:
+        """Messages logged so far."""
+        return sum(len(times) for parts in self._pending.values() for times, _ in parts)
+
     # -- lifecycle --------------------------------------------------------------------------------
     def _flush_topics(self) -> None:
         for topic, parts in self._pending.items():
@@ -183,10 +212,7 @@ class RunWriter:
         self._writer.write_metadata(METADATA_NAME, {**self.metadata, "status": status})
         self._writer.close()
         self._open = False
-        with open(self._partial, "rb+") as f:
-            os.fsync(f.fileno())
-        os.replace(self._partial, self.path)
-        return self.path
+        return files.publish(self._partial, self.path)
 
     def abort(self) -> None:
         """Drop the unfinished file (interrupt): the previous complete run, if any, is untouched."""
@@ -228,6 +254,18 @@ class Run:
 
     def __repr__(self) -> str:
         return f"Run({self.path.name}, status={self.status!r}, topics={self.topic_names})"
+
+    def verify(self) -> Run:
+        """Decompress every chunk and check its CRC: a damaged file fails here, not halfway through an
+        analysis (C-speed decompression, no message decoding)."""
+        with open(self.path, "rb") as f:
+            summary = make_reader(f).get_summary()
+            if summary is None:
+                raise ValueError(f"{self.path.name} has no summary: not a complete run file")
+            for index in summary.chunk_indexes:
+                f.seek(index.chunk_start_offset + 9)  # past the record's opcode (1 byte) and length (8)
+                get_chunk_data_stream(Chunk.read(ReadDataStream(f)), validate_crc=True)
+        return self
 
     @property
     def run_id(self) -> str:

@@ -13,8 +13,10 @@ from pathlib import Path
 from omegaconf import DictConfig, OmegaConf
 from tqdm import tqdm
 
-from pipeline.core import provenance
+from pipeline.core import interrupts, provenance
+from pipeline.core.checks import BadInput, check_cases
 from pipeline.core.experiment import resolve
+from pipeline.core.files import Busy, Locks, stale_partials
 from pipeline.core.runlog import CONFIG_ATTACHMENT, RunWriter, SimulationFailed
 
 # Overrides that do not change what is simulated, so they do not name a run.
@@ -48,40 +50,66 @@ def simulate(cfg: DictConfig, experiment_id: str, overrides: list[str] | None = 
 
     A case that raises SimulationFailed is recorded as `failed: <reason>` and the next case runs.
     Any other exception is recorded the same way, printed, and counted, so the caller can exit != 0.
+    An interrupt (SIGINT, SIGTERM) is never a status: the open run is dropped, earlier complete files stay,
+    and Interrupted propagates, even when a simulator swallowed the KeyboardInterrupt it raised.
+    Raises BadInput before anything is written if the cases' names are unsafe or another process is
+    writing one of the same runs.
     """
-    slug, name, experiment, _ = resolve(experiment_id)
+    experiment = resolve(experiment_id)
+    slug, name = experiment.slug, experiment.name
     params = run_params(overrides or [])
-    out_dir = Path(cfg.data_dir) / "runs" / slug / name
+    data_dir = Path(cfg.data_dir)
+    out_dir = data_dir / "runs" / slug / name
     config_yaml = OmegaConf.to_yaml(cfg, resolve=True)
-    cases = experiment(cfg)
+    cases = check_cases(cfg, experiment)
+    ids = [run_id(case.id, params) for case in cases]
+    interrupts.install()
+    locks = Locks(data_dir, [f"{slug}/{name}/{rid}" for rid in ids])
+    try:
+        locks.acquire()
+    except Busy as busy:
+        raise BadInput(f"another process is writing run {busy} under {data_dir}: wait for it, or use another "
+                       "data_dir") from None
     errors = 0
-    bar = tqdm(cases, desc=experiment_id, unit="run", disable=None if cfg.progress else True,
-               leave=False, file=sys.stderr)
-    for case in bar:
-        rid = run_id(case.id, params)
-        bar.set_postfix_str(rid)
-        metadata = {
-            "slug": slug, "experiment": name, "run_id": rid, "case": case.id, "seed": str(cfg.seed),
-            "params": params, "git_revision": provenance.git_revision(),
-            "package_versions": provenance.package_versions(), "machine": provenance.machine(),
-            "created": dt.datetime.now(dt.UTC).isoformat(timespec="seconds"),
-        }
-        with RunWriter(out_dir / f"{rid}.mcap", metadata) as writer:
-            writer.attach(CONFIG_ATTACHMENT, config_yaml, "application/yaml")
-            start = time.perf_counter()
-            try:
-                case.simulate(writer)
-                status = "ok"
-            except SimulationFailed as err:
-                status = f"failed: {err}"
-            except Exception as err:  # a bug, not physics: keep the record, but make it loud
-                errors += 1
-                status = f"failed: {type(err).__name__}: {err}"
-                traceback.print_exc()
-            writer.metadata["wall_time_s"] = f"{time.perf_counter() - start:.3f}"
-            path = writer.close(status)
-        if status != "ok":
-            tqdm.write(f"{experiment_id} {rid}: {status}", file=sys.stderr)
-        else:
-            tqdm.write(f"wrote {path}", file=sys.stderr)
+    try:
+        for rid in ids:  # left by writers that died: nobody else can hold these names now
+            for stale in stale_partials(out_dir / f"{rid}.mcap"):
+                stale.unlink(missing_ok=True)
+        bar = tqdm(list(zip(cases, ids, strict=True)), desc=experiment_id, unit="run",
+                   disable=None if cfg.progress else True, leave=False, file=sys.stderr)
+        for case, rid in bar:
+            bar.set_postfix_str(rid)
+            status, bug = _run_case(case, rid, out_dir, config_yaml, {
+                "slug": slug, "experiment": name, "run_id": rid, "case": case.id, "seed": str(cfg.seed),
+                "params": params, "git_revision": provenance.git_revision(),
+                "package_versions": provenance.package_versions(), "machine": provenance.machine(),
+                "created": dt.datetime.now(dt.UTC).isoformat(timespec="seconds"),
+            })
+            errors += bug
+            tqdm.write(f"{experiment_id} {rid}: {status}" if status != "ok" else f"wrote {out_dir / rid}.mcap",
+                       file=sys.stderr)
+    finally:
+        locks.release()
     return errors
+
+
+def _run_case(case, rid: str, out_dir: Path, config_yaml: str, metadata: dict) -> tuple[str, bool]:
+    """Simulate one case into its run file; (status, whether a bug rather than physics failed it)."""
+    bug = False
+    with RunWriter(out_dir / f"{rid}.mcap", metadata) as writer:
+        writer.attach(CONFIG_ATTACHMENT, config_yaml, "application/yaml")
+        start = time.perf_counter()
+        try:
+            case.simulate(writer)
+            status = "ok" if writer.messages else "failed: nothing was simulated (no message was logged)"
+        except SimulationFailed as err:
+            interrupts.raise_if_received()  # a simulator that turned Ctrl-C into its own failure
+            status = f"failed: {err}"
+        except Exception as err:  # a bug, not physics: keep the record, but make it loud
+            interrupts.raise_if_received()
+            status, bug = f"failed: {type(err).__name__}: {err}", True
+            traceback.print_exc()
+        interrupts.raise_if_received()  # swallowed entirely: the run may be cut short, do not publish it
+        writer.metadata["wall_time_s"] = f"{time.perf_counter() - start:.3f}"
+        writer.close(status)
+    return status, bug

@@ -19,7 +19,7 @@ spatial). The importable API (SI units, body-frame twists [v; ω] and wrenches [
 
 from __future__ import annotations
 
-from pipeline.core.experiment import ANGLE, NON_NEGATIVE, POSITIVE, Range
+from pipeline.core.experiment import ANGLE, POSITIVE, Budget, Length, OneOf, Range, Rule
 from pipeline.papers.admittance_assembly.design import design_admittance, state_samples
 from pipeline.papers.admittance_assembly.geometry import PegInHole, contacts, line_vector, unit_wrenches
 from pipeline.papers.admittance_assembly.insertion import insert
@@ -41,18 +41,46 @@ def __getattr__(name: str):
 
 _BOX = {"tilt": ANGLE, "tilt_x": ANGLE, "twist": ANGLE, "lateral": Range(ge=-0.01, le=0.01),
         "clearance": Range(gt=0, le=0.01)}
-LIMITS: dict[str, Range] = {
+CASES = ("planar", "spatial")
+LIMITS = {
+    "scenario.cases": (Length(1, 2), OneOf(CASES)), "scenario.runs": (Length(1, 2), OneOf(("static", "insertion"))),
+    "scenario.admittances": (Length(1, 2), OneOf(("designed", "isotropic"))),
+    "scenario.admittance": OneOf(("designed", "isotropic")),
+    "mujoco.integrator": OneOf(("discrete", "implicit", "implicitfast", "Euler", "RK4")),
+    "scenario.duration": Range(gt=0, le=60), "scenario.dt": Range(ge=1e-4, le=0.05),
+    "scenario.insertion_dt": Range(ge=1e-4, le=0.05), "mujoco.timestep": Range(ge=1e-5, le=0.01),
     "system.peg.half_width": Range(gt=0, le=1.0), "system.peg.length": Range(gt=0, le=2.0),
     "system.peg.ref_height": Range(ge=-2.0, le=2.0), "system.hole.clearance": Range(gt=0, le=0.01),
     "system.hole.depth": POSITIVE, "system.selected_height": Range(ge=-2.0, le=2.0),
     "system.nominal_speed": POSITIVE, "system.admittance.translational": POSITIVE,
-    "system.admittance.min_eigenvalue": Range(gt=0, lt=1), "system.admittance.restarts": NON_NEGATIVE,
+    "system.admittance.min_eigenvalue": Range(gt=0, lt=1), "system.admittance.restarts": Range(ge=0, le=50),
     **{f"system.state.{case}.{key}": r for case in ("planar", "spatial") for key, r in _BOX.items()},
-    "scenario.interior_samples": POSITIVE, "scenario.random_admittances": POSITIVE,
-    "scenario.random_interior_samples": POSITIVE, "scenario.timing_repeats": POSITIVE, "scenario.trials": POSITIVE,
-    "scenario.active_gap": POSITIVE, "scenario.predict_gap": POSITIVE, "scenario.log_dt": POSITIVE,
-    "scenario.tf_dt": POSITIVE,
-    "scenario.insertion_dt": POSITIVE, "scenario.static_duration": POSITIVE, "scenario.settle": NON_NEGATIVE,
-    "scenario.static_forces": POSITIVE,
-    "mujoco.timestep": POSITIVE, "mujoco.solref": POSITIVE, "mujoco.solimp": Range(ge=0, le=10),
+    "scenario.interior_samples": Range(ge=1, le=1_000_000), "scenario.random_admittances": Range(ge=1, le=100_000),
+    "scenario.random_interior_samples": Range(ge=1, le=1_000_000), "scenario.timing_repeats": Range(ge=1, le=100_000),
+    "scenario.trials": Range(ge=1, le=100),
+    "scenario.active_gap": POSITIVE, "scenario.predict_gap": POSITIVE,
+    "scenario.static_duration": Range(gt=0, le=10), "scenario.settle": Range(ge=0, le=10),
+    "scenario.static_forces": Range(gt=0, le=1000),
+    "mujoco.solref": POSITIVE, "mujoco.solimp": Range(ge=0, le=10),
+}
+RULES = (
+    Rule(("scenario.settle", "scenario.static_duration"), lambda settle, duration: settle < duration,
+         "scenario.settle={0:g} s must be shorter than scenario.static_duration={1:g} s"),
+    Rule(("scenario.log_dt", "scenario.dt"), lambda log_dt, dt: log_dt >= dt,
+         "scenario.log_dt={0:g} s is shorter than the step scenario.dt={1:g} s"),
+    Rule(("scenario.log_dt", "scenario.duration"), lambda log_dt, T: log_dt <= T / 10,
+         "scenario.log_dt={0:g} s leaves fewer than 10 samples of the {1:g} s run"),
+    Rule(("scenario.random_interior_samples", "scenario.interior_samples"), lambda used, drawn: used <= drawn,
+         "scenario.random_interior_samples={0} exceeds the {1} interior samples drawn"),
+)
+BUDGETS = {
+    "corner-conditions": Budget("condition checks", lambda c: len(c.scenario.cases) * (
+        c.scenario.interior_samples + c.scenario.random_admittances * c.scenario.random_interior_samples
+        + c.scenario.timing_repeats), 1e8, "fewer samples or random admittances"),
+    "insertion": Budget("quasi-static steps", lambda c: len(c.scenario.cases) * len(c.scenario.admittances)
+                        * c.scenario.trials * c.scenario.duration / c.scenario.dt, 1e6,
+                        "fewer scenario.trials, a shorter scenario.duration or a longer scenario.dt"),
+    "mujoco-crosscheck": Budget("physics steps", lambda c: len(c.scenario.cases) * (
+        c.scenario.static_duration + c.scenario.duration) / c.mujoco.timestep, 5e6,
+        "a shorter scenario.duration or a longer mujoco.timestep"),
 }

@@ -13,7 +13,7 @@ The importable API (SI units, prototype v.1 of Sect. 5 from conf/system/gripper-
 
 from __future__ import annotations
 
-from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, Range
+from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, Budget, Length, OneOf, Range, Rule, Text
 from pipeline.papers.gripper_force_control.drive import Drive, Schedule, move_duration, schedule, trapezoid
 from pipeline.papers.gripper_force_control.lumped import Start, Trace, static_grasp
 from pipeline.papers.gripper_force_control.lumped import simulate as simulate_lumped
@@ -39,7 +39,21 @@ def __getattr__(name: str):
 
 
 _G = "system.geometry."
-LIMITS: dict[str, Range] = {
+PLANTS = ("mujoco", "lumped")
+COUPLINGS = ("eq5", "eq9", "unity")
+FEEDFORWARDS = ("model", "printed")
+LIMITS = {
+    "system.gearbox.g_pf_form": OneOf(("pf_over_ps2", "ps2_over_pf")), "system.gearbox.coupling": OneOf(COUPLINGS),
+    "system.motors.back_emf": OneOf(("printed", "torque_constant")),
+    "system.controller.feedforward": OneOf(FEEDFORWARDS),
+    "system.controller.dt": Range(ge=1e-6, le=1e-3), "system.controller.velocity_dt": Range(ge=1e-6, le=1e-2),
+    "system.controller.position_dt": Range(ge=1e-6, le=1e-2),
+    "scenario.plant": OneOf(PLANTS), "scenario.plants": (Length(1, 2), OneOf(PLANTS)),
+    "scenario.forms": Length(0, 10), "scenario.forms.plant": OneOf(PLANTS),
+    "scenario.forms.coupling": OneOf(COUPLINGS), "scenario.forms.feedforward": OneOf(FEEDFORWARDS),
+    "scenario.tables": Text(), "scenario.forces": (Length(1, 20), Range(gt=0, le=200)),
+    "scenario.grasps": Range(ge=1, le=1000), "scenario.duration": Range(gt=0, le=10),
+    "log_dt": Range(ge=1e-5, le=0.1), "tf_dt": Range(ge=1e-5, le=0.1), "mujoco.settle": Range(ge=0, le=1),
     **{_G + k: POSITIVE for k in ("D_pd", "D_pu", "D_pf", "D_ps1", "D_ps2", "D_pc", "l_f")},
     _G + "h_pc": NON_NEGATIVE,
     **{f"system.motors.{k}": POSITIVE for k in ("R", "L", "K_t", "K_e", "J_M1", "J_M2", "voltage_limit",
@@ -51,12 +65,31 @@ LIMITS: dict[str, Range] = {
     "system.contact.damping": NON_NEGATIVE,
     **{f"system.friction.{k}": NON_NEGATIVE for k in ("m1_coulomb", "m1_viscous", "rotation_coulomb",
                                                        "rotation_viscous")},
-    "scenario.force": POSITIVE, "scenario.forces": POSITIVE, "scenario.tomato_force": POSITIVE,
+    "scenario.force": Range(gt=0, le=200), "scenario.tomato_force": Range(gt=0, le=200),
     "scenario.angle": Range(gt=0, le=6.2832), "scenario.omega": POSITIVE, "scenario.epsilon": POSITIVE,
     "scenario.start": NON_NEGATIVE, "scenario.after": NON_NEGATIVE, "scenario.pause": NON_NEGATIVE,
     "scenario.stroke": POSITIVE, "scenario.stop_margin": NON_NEGATIVE, "scenario.rotate_at": NON_NEGATIVE,
     "scenario.open_at": NON_NEGATIVE,
-    "scenario.grasps": POSITIVE, "scenario.gap": POSITIVE, "scenario.friction_scale": NON_NEGATIVE,
-    "scenario.window": POSITIVE, "log_dt": POSITIVE, "tf_dt": POSITIVE, "mujoco.settle": NON_NEGATIVE,
+    "scenario.gap": POSITIVE, "scenario.friction_scale": NON_NEGATIVE, "scenario.window": POSITIVE,
     "scenario.cases.tomato.speed_limit": POSITIVE, "scenario.cases.no-speed-limit.speed_limit": POSITIVE,
+}
+RULES = (
+    Rule(("system.controller.velocity_dt", "system.controller.dt"), lambda v, dt: v >= dt,
+         "system.controller.velocity_dt={0:g} s is shorter than the current-loop step system.controller.dt={1:g} s"),
+    Rule(("system.controller.position_dt", "system.controller.velocity_dt"), lambda p, v: p >= v,
+         "system.controller.position_dt={0:g} s is shorter than system.controller.velocity_dt={1:g} s"),
+    Rule(("log_dt", "system.controller.dt"), lambda log_dt, dt: log_dt >= dt,
+         "log_dt={0:g} s is shorter than the simulation step system.controller.dt={1:g} s"),
+    Rule(("scenario.window", "scenario.duration"), lambda window, T: window < T,
+         "scenario.window={0:g} s must be shorter than scenario.duration={1:g} s"),
+    Rule(("scenario.open_at", "scenario.duration"), lambda t, T: t < T,
+         "scenario.open_at={0:g} s must come before the end of the run, scenario.duration={1:g} s"),
+    Rule(("scenario.rotate_at", "scenario.open_at"), lambda rotate, open_: rotate < open_,
+         "scenario.rotate_at={0:g} s must come before scenario.open_at={1:g} s"),
+)
+_STEPS = 2e7  # controller ticks of one experiment: about 100 s of wall time
+BUDGETS = {
+    "steady-state": Budget("controller ticks", lambda c: len(c.scenario.forces) * c.scenario.grasps
+                           * c.scenario.duration / c.system.controller.dt, _STEPS,
+                           "fewer scenario.grasps or a shorter scenario.duration"),
 }

@@ -14,7 +14,7 @@ The importable API (SI units, the Stäubli TX2-90 of Table 2):
 
 from __future__ import annotations
 
-from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, PROBABILITY, OneOf, Range
+from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, PROBABILITY, Budget, Length, OneOf, Range, Rule, Text
 from pipeline.papers.nmpc_cdkd.kinematics import (
     Arm,
     hand_jacobian,
@@ -44,33 +44,58 @@ def __getattr__(name: str):
     raise AttributeError(name)
 
 
-LIMITS: dict[str, Range | OneOf] = {
+LIMITS = {
+    "system.dt": Range(ge=1e-3, le=0.1), "system.planning.sample_dt": Range(ge=1e-3, le=0.1),
+    "system.plant.physics_dt": Range(ge=1e-5, le=0.01), "system.scene.obstacles.names": Text(),
+    "scenario.t1": Range(gt=0, le=30), "scenario.settle": Range(ge=0, le=10), "scenario.duration": Range(gt=0, le=30),
+    "scenario.moves": Range(ge=1, le=1000), "scenario.tool_lengths": (Length(1, 5), NON_NEGATIVE),
+    "scenario.horizons": (Length(1, 5), Range(ge=2, le=200)),
     "system.nmpc.integrator": OneOf(("rk4", "euler")), "system.nmpc.warm_start": OneOf(("shift", "reference")),
     "system.nmpc.obstacle_prediction": OneOf(("constant_velocity", "frozen")),
     "system.nmpc.on_failure": OneOf(("solver_iterate", "previous_plan")),
     "system.nmpc.initial_state": OneOf(("command", "measured")),
     "system.orientation.desired_from": OneOf(("command", "measured")),
-    "system.plant.kind": OneOf(("mujoco", "kinematic")), "scenario.models": OneOf(("decomposed", "full")),
-    "scenario.cases": OneOf(("no-obstacle", "obstacle", "obstacle-height", "a", "b", "A", "B", "fixed")),
+    "system.plant.kind": OneOf(("mujoco", "kinematic")),
+    "scenario.models": (Length(1, 2), OneOf(("decomposed", "full"))),
+    "scenario.cases": (Length(1, 3), OneOf(("no-obstacle", "obstacle", "obstacle-height", "a", "b", "A", "B"))),
     "system.dh.a": NON_NEGATIVE, "system.dh.d": Range(ge=-2, le=2), "system.dh.wrist_a": POSITIVE,
     "system.dh.wrist_d": NON_NEGATIVE, "system.dh.tool_d": NON_NEGATIVE,
     "system.joint_limits.velocity": POSITIVE, "system.joint_limits.acceleration": POSITIVE,
     "system.joint_limits.jerk": POSITIVE,
     "system.nmpc.horizon_steps": Range(ge=2, le=200), "system.nmpc.control_steps": Range(ge=1, le=200),
     "system.nmpc.mu": NON_NEGATIVE, "system.nmpc.length_unit": POSITIVE, "system.nmpc.tol": POSITIVE,
-    "system.nmpc.acceptable_obj_change_tol": POSITIVE, "system.nmpc.max_iter": Range(ge=1),
+    "system.nmpc.acceptable_obj_change_tol": POSITIVE, "system.nmpc.max_iter": Range(ge=1, le=100_000),
     "system.full.orientation_lever": NON_NEGATIVE, "system.orientation.gain": NON_NEGATIVE,
-    "system.planning.sample_dt": POSITIVE, "system.planning.wrist_band": Range(ge=0, le=1.5708),
+    "system.planning.wrist_band": Range(ge=0, le=1.5708),
     "system.planning.limit_margin": Range(gt=0, le=1),
-    "system.plant.physics_dt": POSITIVE, "system.plant.bandwidth_hz": POSITIVE,
+    "system.plant.bandwidth_hz": POSITIVE,
     "system.plant.damping_ratio": POSITIVE, "system.plant.link_radius": POSITIVE,
     "system.plant.armature": NON_NEGATIVE, "system.plant.damping": NON_NEGATIVE,
     "system.plant.torque_limit": POSITIVE,
     "system.scene.obstacles.radii": POSITIVE,
-    "scenario.t0": NON_NEGATIVE, "scenario.t1": POSITIVE, "scenario.settle": NON_NEGATIVE,
-    "scenario.moves": Range(ge=1), "scenario.horizons": Range(ge=2, le=200),
-    "scenario.min_transition_time": POSITIVE, "scenario.tool_lengths": NON_NEGATIVE, "scenario.wrist_radius": POSITIVE,
+    "scenario.t0": NON_NEGATIVE,
+    "scenario.min_transition_time": Range(gt=0, le=30), "scenario.wrist_radius": POSITIVE,
     "scenario.azimuth_change": Range(gt=0, le=3.1416), "scenario.obstacle.radius": POSITIVE,
     "scenario.obstacle.drop": Range(ge=0, le=1), "scenario.obstacle.offset": PROBABILITY,
     "scenario.obstacle.clearance": NON_NEGATIVE,
+}
+RULES = (
+    Rule(("system.plant.physics_dt", "system.dt"), lambda physics_dt, dt: physics_dt <= dt,
+         "system.plant.physics_dt={0:g} s exceeds the robot update system.dt={1:g} s"),
+    Rule(("scenario.t0", "scenario.t1"), lambda t0, t1: t0 < t1, "scenario.t0={0:g} s must come before scenario.t1"),
+    Rule(("scenario.t1", "scenario.duration"), lambda t1, T: t1 <= T,
+         "scenario.t1={0:g} s must not come after the end of the run, scenario.duration={1:g} s"),
+    Rule(("system.nmpc.control_steps", "system.nmpc.horizon_steps"), lambda m, n: m <= n,
+         "system.nmpc.control_steps={0} exceeds the prediction horizon system.nmpc.horizon_steps={1}"),
+)
+_SOLVES = 2e5  # OCP solves of one experiment (a few ms each)
+BUDGETS = {
+    "compute-time": Budget("OCP solves", lambda c: c.scenario.moves * len(c.scenario.models) * len(c.scenario.cases)
+                           * len(c.scenario.horizons) * (c.scenario.t0 + 2 * c.scenario.min_transition_time
+                                                         + c.scenario.settle) / c.system.dt, _SOLVES,
+                           "fewer scenario.moves"),
+    **{name: Budget("OCP solves", lambda c: len(c.scenario.get("cases", [0])) * len(c.scenario.get("models", [0]))
+                    * len(c.scenario.get("tool_lengths", [0])) * c.scenario.duration / c.system.dt, _SOLVES,
+                    "a shorter scenario.duration or a longer system.dt")
+       for name in ("tracking", "fixed-obstacles", "moving-obstacles")},
 }

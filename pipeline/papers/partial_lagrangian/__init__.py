@@ -15,7 +15,7 @@ The importable API (SI units; planar chains of point masses, angles from +x, rel
 
 from __future__ import annotations
 
-from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, OneOf, Range
+from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, Budget, Length, OneOf, Range, Rule
 from pipeline.papers.partial_lagrangian.chain import (
     DAMPING_MODELS,
     PRISMATIC,
@@ -54,19 +54,45 @@ def __getattr__(name: str):
 
 
 LINKS = Range(ge=1, le=10)   # the configured parameter lists hold 10 links (Sect. 4: up to 10 DoF)
-LIMITS: dict[str, Range | OneOf] = {
+DURATION = Range(gt=0, le=600)
+LIMITS = {
     "system.damping_model": OneOf(DAMPING_MODELS), "system.simulation.formulation": OneOf(FORMS),
     "system.simulation.integrator": OneOf(INTEGRATORS), "scenario.joints": OneOf((REVOLUTE, PRISMATIC)),
-    "scenario.cases": OneOf(("free", "pd")),
+    "scenario.cases": (Length(1, 2), OneOf(("free", "pd"))),
+    "scenario.energy_integrators": (Length(1, 2), OneOf(INTEGRATORS)),
+    # explicit schemes on these chains (periods ~1 s, ten links stiffer) are stable well below 10 ms
+    "system.simulation.dt": Range(ge=1e-5, le=0.01),
     "system.gravity": NON_NEGATIVE, "system.links.mass": POSITIVE, "system.links.length": POSITIVE,
     "system.links.damping": NON_NEGATIVE, "system.links.stiffness": NON_NEGATIVE,
-    "system.logging.log_dt": POSITIVE, "system.logging.tf_dt": POSITIVE,
-    "scenario.links": LINKS, "scenario.slider_angle_deg": Range(ge=-360, le=360),
-    "scenario.free.duration": POSITIVE, "scenario.pd.duration": POSITIVE, "scenario.duration": POSITIVE,
+    "scenario.links": (Length(1, 10), LINKS), "scenario.slider_angle_deg": Range(ge=-360, le=360),
+    "scenario.free.duration": DURATION, "scenario.pd.duration": DURATION, "scenario.duration": DURATION,
     "scenario.pd.kp": NON_NEGATIVE, "scenario.pd.kd": NON_NEGATIVE, "scenario.pd.reference_deg": Range(ge=-360, le=360),
     "scenario.pid.kp": NON_NEGATIVE, "scenario.pid.ki": NON_NEGATIVE, "scenario.pid.kd": NON_NEGATIVE,
-    "scenario.pid.reference": POSITIVE, "scenario.states": POSITIVE, "scenario.eval_repeats": POSITIVE,
-    "scenario.build_repeats": POSITIVE, "scenario.warmup": NON_NEGATIVE, "scenario.batch_instructions": POSITIVE,
-    "scenario.mujoco_batch": POSITIVE,
-    "scenario.trajectory_duration": POSITIVE, "scenario.energy_duration": POSITIVE,
+    "scenario.pid.reference": POSITIVE, "scenario.states": Range(ge=1, le=100_000),
+    "scenario.eval_repeats": Range(ge=1, le=10_000), "scenario.build_repeats": Range(ge=1, le=1000),
+    "scenario.warmup": Range(ge=0, le=1000), "scenario.batch_instructions": Range(ge=1, le=10_000_000),
+    "scenario.mujoco_batch": Range(ge=1, le=100_000),
+    "scenario.trajectory_duration": DURATION, "scenario.energy_duration": DURATION,
+}
+RULES = (
+    Rule(("system.logging.log_dt", "system.simulation.dt"), lambda log_dt, dt: log_dt >= dt,
+         "system.logging.log_dt={0:g} s is shorter than the step system.simulation.dt={1:g} s"),
+)
+
+
+def _simulated_seconds(c) -> float:
+    sc = c.scenario
+    return sum(sc[case].duration for case in sc.get("cases", ()) if case in sc) + sc.get("duration", 0.0)
+
+
+BUDGETS = {
+    **{name: Budget("integration steps", lambda c: _simulated_seconds(c) / c.system.simulation.dt, 2e6,
+                    "a shorter duration or a longer system.simulation.dt")
+       for name in ("one-link", "two-link", "three-link", "ten-link", "slider")},
+    "checks": Budget("integration steps", lambda c: len(c.scenario.links) * (
+        c.scenario.trajectory_duration + 2 * c.scenario.energy_duration) / c.system.simulation.dt, 2e6,
+        "shorter durations or a longer system.simulation.dt"),
+    "compute-time": Budget("timed evaluations", lambda c: len(c.scenario.links) * (
+        c.scenario.eval_repeats * (c.scenario.batch_instructions / 1000 + c.scenario.mujoco_batch)
+        + c.scenario.build_repeats * 100), 1e7, "fewer repeats or smaller batches"),
 }

@@ -14,7 +14,7 @@ The importable API (SI units, Table 1 plus the stated assumptions of conf/system
 
 from __future__ import annotations
 
-from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, PROBABILITY, Range
+from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, PROBABILITY, Budget, Length, OneOf, Range, Rule
 from pipeline.papers.scara_half_derivative.arm import Arm, balanced_theta3p, fk, gravity_torque, ik, jacobian
 from pipeline.papers.scara_half_derivative.controller import CartesianController, Gains
 from pipeline.papers.scara_half_derivative.setpoint import Motion
@@ -34,19 +34,44 @@ def __getattr__(name: str):
     raise AttributeError(name)
 
 
-LIMITS: dict[str, Range] = {
+STEP = Range(ge=1e-5, le=0.05)
+LIMITS = {
+    "scenario.controllers": (Length(1, 3), OneOf(("kd", "kdhd", "khd"))),
+    "execute.plant": OneOf(("exudyn", "lagrange")), "system.control.dt": Range(ge=1e-4, le=0.05),
+    "execute.dt": STEP, "scenario.dt": STEP, "scenario.k_xyz": (Length(1, 10), POSITIVE),
+    "scenario.d_xyz": (Length(1, 50), NON_NEGATIVE),
     **{f"system.geometry.{k}": POSITIVE for k in ("l1", "l2", "l3", "l4", "lG1", "lG3", "lG4", "h")},
     "system.inertia": POSITIVE, "system.gravity": NON_NEGATIVE, "system.spring.k3": POSITIVE,
     "system.spring.theta3p_deg": Range(ge=-90, le=90), "system.home_deg": Range(ge=-180, le=180),
     "system.motion.distance": Range(gt=0, le=0.3), "system.motion.t_move": POSITIVE,
     "system.motion.t_stop": NON_NEGATIVE, "system.motion.accel_fraction": Range(gt=0, le=0.5),
     "system.motion.directions": Range(ge=-1, le=1),
-    "system.control.dt": POSITIVE, "system.control.gl_terms": Range(ge=1, le=10_000),
+    "system.control.gl_terms": Range(ge=1, le=10_000),
     "system.control.k_theta": NON_NEGATIVE,
     **{f"system.control.rotation.{law}.{k}": NON_NEGATIVE for law in ("kd", "kdhd") for k in ("d_theta", "hd_theta")},
-    "scenario.duration": Range(gt=0, le=600), "scenario.k_xyz": POSITIVE, "scenario.d_xyz": NON_NEGATIVE,
-    "scenario.hd_xyz": NON_NEGATIVE, "scenario.tf_dt": POSITIVE,
+    "scenario.duration": Range(gt=0, le=600), "scenario.hd_xyz": NON_NEGATIVE,
     **{f"scenario.tunings.{c}.{k}": NON_NEGATIVE for c in ("kd", "kdhd", "khd") for k in ("d_xyz", "hd_xyz")},
-    "execute.dt": POSITIVE, "execute.log_dt": POSITIVE, "execute.tf_dt": POSITIVE,
     "execute.spectral_radius": PROBABILITY, "execute.newton_tolerance": Range(gt=0, lt=1),
+}
+
+
+def _whole(period: float, step: float) -> bool:
+    return step <= period and abs(period / step - round(period / step)) < 1e-9
+
+
+RULES = (
+    Rule(("system.control.dt", "execute.dt"), _whole,
+         "execute.dt={1:g} s must divide the control period system.control.dt={0:g} s (torques are held over it)"),
+    Rule(("execute.log_dt", "execute.dt"), lambda log_dt, dt: log_dt >= dt,
+         "execute.log_dt={0:g} s is shorter than the integration step execute.dt={1:g} s"),
+)
+_STEPS = 5e6  # integration steps of one experiment: Exudyn runs ~7000 per wall second
+BUDGETS = {
+    "table2": Budget("integration steps", lambda c: len(c.scenario.controllers) * len(c.scenario.k_xyz)
+                     * c.scenario.duration / c.execute.dt, _STEPS,
+                     "a shorter scenario.duration or a longer execute.dt"),
+    "maps": Budget("integration steps", lambda c: c.scenario.duration / c.execute.dt, _STEPS,
+                   "a shorter scenario.duration or a longer execute.dt"),
+    "locus": Budget("integration steps", lambda c: len(c.scenario.k_xyz) * len(c.scenario.d_xyz)
+                    * c.scenario.duration / c.execute.dt, _STEPS, "fewer points or a longer execute.dt"),
 }

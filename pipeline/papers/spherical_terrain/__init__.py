@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 
-from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, Range
+from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, Budget, Length, OneOf, Range, Rule
 from pipeline.papers.spherical_terrain.kinematics import (
     CosineTerrain,
     contact_xy_velocity,
@@ -62,7 +62,14 @@ def __getattr__(name: str):
 
 
 _GAIN = NON_NEGATIVE
-LIMITS: dict[str, Range] = {
+FORM = OneOf(("corrected", "printed"))
+LIMITS = {
+    "scenario.classes": (Length(1, 4), OneOf(("3r", "2r", "rt", "rs"))),
+    "scenario.paths": (Length(1, 2), OneOf(("circle", "diamond"))),
+    "system.form.eq25": FORM, "system.form.eq58": FORM, "system.form.eq60": FORM,
+    "system.dt": Range(ge=1e-4, le=0.05), "system.duration": Range(gt=0, le=1000),
+    # a coarser field than 1 cm...0.5 m misses the terrain's 3.1 m wavelength or grows past 400k samples
+    "system.physics.grid": Range(ge=0.01, le=0.5), "system.physics.timestep": Range(ge=1e-4, le=0.01),
     "system.terrain.amplitude": NON_NEGATIVE, "system.terrain.frequency": NON_NEGATIVE,
     "system.radius": POSITIVE, "system.tilt_limit": Range(gt=0, le=math.pi / 2),
     "system.paths.circle.radius": POSITIVE, "system.paths.circle.rate": Range(ge=-10, le=10),
@@ -72,7 +79,16 @@ LIMITS: dict[str, Range] = {
        {"3r": ("k_theta", "k_phi1", "k_phi2", "k_psi"), "2r": ("k_theta1", "k_theta2", "k_phi1", "k_phi2"),
         "rt": ("k_theta", "k_psi"), "rs": ("k_alpha", "k_phi")}.items() for k in keys},
     "system.start.heading": Range(ge=-2 * math.pi, le=2 * math.pi),
-    "system.log_dt": POSITIVE, "system.tf_dt": POSITIVE,
-    "system.physics.friction": POSITIVE, "system.physics.grid": POSITIVE, "system.physics.half_extent": POSITIVE,
-    "system.physics.timestep": POSITIVE, "system.physics.servo_gain": POSITIVE, "system.physics.torque_limit": POSITIVE,
+    "system.physics.friction": POSITIVE, "system.physics.half_extent": Range(gt=0, le=20),
+    "system.physics.servo_gain": POSITIVE, "system.physics.torque_limit": POSITIVE,
 }
+RULES = (
+    Rule(("system.physics.timestep", "system.dt"),
+         lambda step, dt: step <= dt and abs(dt / step - round(dt / step)) < 1e-9,
+         "system.physics.timestep={0:g} s must divide the controller period system.dt={1:g} s"),
+    Rule(("system.log_dt", "system.duration"), lambda log_dt, T: log_dt <= T / 10,
+         "system.log_dt={0:g} s leaves fewer than 10 samples of the {1:g} s run"),
+)
+_STEPS = Budget("steps", lambda c: len(c.scenario.classes) * len(c.scenario.paths) * c.system.duration
+                 / c.system.physics.timestep, 2e7, "fewer classes or paths, or a shorter system.duration")
+BUDGETS = dict.fromkeys(("paths", "printed", "sweep", "physics-check"), _STEPS)

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, Range
+from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, Budget, Length, OneOf, Range, Rule, Text
 from pipeline.papers.ur5_ik_fsm import ik
 from pipeline.papers.ur5_ik_fsm.ik import PAPER, Conventions
 from pipeline.papers.ur5_ik_fsm.kinematics import UR5, Geometry, det_j, fk, jacobian, shoulder_term
@@ -56,7 +56,19 @@ def __getattr__(name: str):
     raise AttributeError(name)
 
 
-LIMITS: dict[str, Range] = {
+STEP = Range(ge=1e-5, le=0.1)   # s: time steps and log periods
+PATHS = ("wrist", "shoulder", "elbow")
+LIMITS = {
+    "system.fk_form": OneOf(("corrected", "printed")),
+    "system.conventions.sqrt_negative": OneOf(("abs", "clamp", "reject")),
+    "scenario.table2": Text(), "scenario.cases": (Length(1, 2), OneOf(("independent", "sequential"))),
+    "scenario.previous": OneOf(("random", "zero")),
+    "scenario.paths": (Length(1, 3), OneOf(PATHS)), "scenario.algorithms": (Length(1, 2), OneOf(("alg1", "alg2"))),
+    "scenario.crossings": (Length(1, 2), OneOf(("near", "through"))),
+    "scenario.duration": Range(gt=0, le=60), "scenario.ik_dt": STEP, "execute.dt": Range(ge=1e-4, le=0.02),
+    "execute.log_dt": STEP, "execute.tf_dt": STEP,
+    "scenario.poses": Range(ge=1, le=1_000_000), "scenario.warmup": Range(ge=0, le=100_000),
+    "scenario.batch_repeats": Range(ge=1, le=1000),
     "system.geometry.d1": POSITIVE, "system.geometry.a2": POSITIVE, "system.geometry.a3": POSITIVE,
     "system.geometry.d4": POSITIVE, "system.geometry.d5": POSITIVE, "system.geometry.d6": POSITIVE,
     "system.conventions.snap_tol": NON_NEGATIVE, "system.conventions.s5_min": NON_NEGATIVE,
@@ -66,8 +78,21 @@ LIMITS: dict[str, Range] = {
     "system.dynamics.link_radius": POSITIVE, "system.dynamics.armature": NON_NEGATIVE,
     "system.dynamics.damping": NON_NEGATIVE, "system.dynamics.torque_limit": POSITIVE,
     "system.dynamics.velocity_limit": POSITIVE,
-    "scenario.ik_dt": POSITIVE, "execute.tf_dt": POSITIVE, "execute.log_dt": POSITIVE, "execute.bandwidth_hz": POSITIVE,
-    "execute.damping_ratio": POSITIVE, "scenario.poses": POSITIVE, "scenario.near_gap": NON_NEGATIVE,
-    "scenario.warmup": NON_NEGATIVE, "scenario.batch_repeats": POSITIVE,
+    "execute.bandwidth_hz": Range(gt=0, le=100), "execute.damping_ratio": POSITIVE, "scenario.near_gap": NON_NEGATIVE,
     "scenario.wrist.length": POSITIVE, "scenario.shoulder.length": POSITIVE, "scenario.elbow.length": POSITIVE,
+}
+RULES = (
+    Rule(("execute.dt", "scenario.ik_dt"), lambda dt, ik_dt: dt <= ik_dt,
+         "execute.dt={0:g} s must not exceed scenario.ik_dt={1:g} s: the servo runs at least as often as the IK"),
+    Rule(("execute.log_dt", "execute.dt"), lambda log_dt, dt: log_dt >= dt,
+         "execute.log_dt={0:g} s is shorter than the physics step execute.dt={1:g} s"),
+    Rule(("execute.log_dt", "scenario.duration"), lambda log_dt, T: log_dt <= T / 10,
+         "execute.log_dt={0:g} s leaves fewer than 10 samples of the {1:g} s path"),
+)
+BUDGETS = {
+    "singular-paths": Budget("physics steps", lambda c: len(c.scenario.paths) * len(c.scenario.algorithms)
+                             * len(c.scenario.crossings) * c.scenario.duration / c.execute.dt, 5e6,
+                             "fewer paths, a shorter scenario.duration or a longer execute.dt"),
+    "compute-time": Budget("IK calls", lambda c: c.scenario.poses * (2 + c.scenario.batch_repeats)
+                           + c.scenario.warmup, 5e7, "fewer scenario.poses or scenario.batch_repeats"),
 }
