@@ -1,0 +1,104 @@
+"""`gripper-force-control`: the figures (PNG + SVG under data/figures/<slug>/<experiment>/, declared in paper.yaml)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from analysis.core.figures import Figures, plt
+from analysis.papers.gripper_force_control.metrics import SAG_CASES, STEADY_BELOW, _config, grasp_forces
+from pipeline.core.runlog import Run
+
+
+def _sag_figure(runs: list[Run], figures: Figures) -> None:
+    by_case = {run.metadata["case"]: run for run in runs}
+    fig, (ax, ax_phi) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, height_ratios=[2, 1])
+    for i, case in enumerate(SAG_CASES):
+        for plant, style in (("mujoco", "-"), ("lumped", "--")):
+            run = by_case.get(f"{case}-{plant}")
+            if run is None:
+                continue
+            t, measured, commanded = grasp_forces(run)
+            ax.plot(t * 1e3, measured, style, color=f"C{i}", lw=1.3 if plant == "mujoco" else 1.0,
+                    label=f"{case} ({plant})")
+    any_run = next(iter(by_case.values()))
+    t, _, commanded = grasp_forces(any_run)
+    ax.plot(t * 1e3, commanded, "k:", lw=1, label="F_set")
+    ax.set_ylabel("grasping force F_f [N]")
+    ax.set_title("Fig. 8: grasping force during a 40° rotation (MuJoCo: contact force; lumped: pad force)")
+    ax.legend(ncol=2, fontsize=7)
+    ref = any_run["/reference"]
+    joints = any_run["/joint_state"]
+    ax_phi.plot(ref.index * 1e3, np.rad2deg(ref["position.gripper"]), "k:", label="φ_sr")
+    ax_phi.plot(joints.index * 1e3, np.rad2deg(joints["position.gripper"]), label="φ_g")
+    ax_phi.set_ylabel("gripper angle [°]")
+    ax_phi.set_xlabel("time [ms]")
+    ax_phi.legend()
+    figures.save(fig, "fig8-force-sag")
+
+
+
+def _surface_figure(grid: pd.DataFrame, figures: Figures) -> None:
+    table = grid.pivot_table(index="epsilon", columns="omega", values="max_error")
+    fig = plt.figure(figsize=(8, 4))
+    if table.shape[0] >= 2 and table.shape[1] >= 2 and not table.isna().any().any():
+        ax = fig.add_subplot(1, 2, 1, projection="3d")
+        W, E = np.meshgrid(table.columns.to_numpy(), table.index.to_numpy())
+        ax.plot_surface(E, W, table.to_numpy(), cmap="viridis", edgecolor="k", lw=0.3)
+        ax.set_xlabel("ε_g [rad/s²]")
+        ax.set_ylabel("ω_g [rad/s]")
+        ax.set_zlabel("max |F_f − F_set| [N]")
+        ax.set_title("Fig. 9 (simulated)", fontsize=9)
+    ax2 = fig.add_subplot(1, 2, 2)
+    sc = ax2.scatter(grid["epsilon"], grid["omega"], c=grid["max_error"], cmap="viridis", s=90)
+    for row in grid.itertuples():
+        ax2.annotate(f"{row.max_error:.2f}", (row.epsilon, row.omega), fontsize=6, ha="center", va="bottom",
+                     xytext=(0, 5), textcoords="offset points")
+    fig.colorbar(sc, ax=ax2, label="max |F_f − F_set| [N]")
+    ax2.set_xlabel("ε_max [rad/s²]")
+    ax2.set_ylabel("ω_max [rad/s]")
+    ax2.set_title(f"{len(grid)} grid points on disk (paper's bound 1.27 N)", fontsize=9)
+    figures.save(fig, "fig9-force-error-surface")
+
+
+
+def _cycle_figure(runs: list[Run], figures: Figures) -> None:
+    fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True)
+    for i, run in enumerate(runs):
+        t, measured, commanded = grasp_forces(run)
+        joints = run["/joint_state"]
+        l_f = float(_config(run, "system", "geometry", "l_f"))
+        label = run.metadata["case"]
+        axes[0].plot(joints.index * 1e3, joints["velocity.finger"] * l_f, color=f"C{i}", label=label)
+        axes[1].plot(t * 1e3, measured, color=f"C{i}", label=label)
+        axes[2].plot(joints.index * 1e3, np.rad2deg(joints["position.gripper"]), color=f"C{i}", label=label)
+        if i == 0:
+            axes[1].plot(t * 1e3, commanded, "k:", label="F_set")
+    axes[0].set_ylabel("finger-end speed [m/s]")
+    axes[1].set_ylabel("grasping force [N]")
+    axes[1].set_yscale("symlog", linthresh=10)
+    axes[2].set_ylabel("gripper angle [°]")
+    axes[2].set_xlabel("time [ms]")
+    for ax in axes:
+        ax.legend(fontsize=7)
+    axes[0].set_title("Pick and place: close at 8.2 N, turn 45°, open (MuJoCo)")
+    figures.save(fig, "pick-and-place")
+
+
+
+def _steady_figure(f_set: np.ndarray, error: np.ndarray, figures: Figures) -> None:
+    fig, (ax, ax_h) = plt.subplots(1, 2, figsize=(9, 3.4))
+    jitter = np.random.default_rng(0).uniform(-0.6, 0.6, f_set.size)
+    ax.scatter(f_set + jitter, error, s=8, alpha=0.6)
+    ax.axhline(0.8, color="r", ls="--", lw=1, label="paper: |error| ≤ 0.8 N (hardware)")
+    ax.axhline(-0.8, color="r", ls="--", lw=1)
+    ax.set_xlabel("F_set [N]")
+    ax.set_ylabel("steady-state error [N]")
+    ax.legend(fontsize=7)
+    ax.set_title("Fig. 7a stand-in: Monte-Carlo grasps (lumped plant)", fontsize=9)
+    ax_h.hist(np.abs(error), bins=20)
+    ax_h.axvline(STEADY_BELOW, color="k", ls=":", lw=1)
+    ax_h.set_xlabel("|steady-state error| [N]")
+    ax_h.set_ylabel("grasps")
+    ax_h.set_title("Fig. 7b stand-in", fontsize=9)
+    figures.save(fig, "fig7-monte-carlo")
