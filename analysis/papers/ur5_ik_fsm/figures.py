@@ -28,13 +28,14 @@ def _table6_figure(metrics: pd.DataFrame, figures: Figures) -> None:
                 alg = t.metric.split(".")[0]
                 shift = (ALGORITHMS.index(alg) - 0.5) * 0.38 if t.target_id.count(".") == 2 else 0.0
                 ax.plot(k + shift, float(t.value), "k_", ms=12, mew=2)
-            ax.plot([], [], "k_", ms=12, mew=2, label="paper, Table 6")
+            ax.plot([], [], "k_", ms=12, mew=2, label="paper (Table 6)")
         ax.set_title(f"previous joints: {'0 (paper)' if case == 'independent' else 'last selection (ours)'}")
         ax.set_xlabel("test")
         ax.set_xticks(tests)
     axes[0].set_ylabel("joint displacement, eq. (48) [rad]")
-    axes[0].legend(loc="lower left")
-    figures.save(fig, "table6-displacement")
+    fig.legend(*axes[0].get_legend_handles_labels(), loc="upper center", ncol=3)   # above the bars, not on them
+    fig.tight_layout(rect=(0, 0, 1, 0.9))
+    figures.save(fig, "table6-displacement", tight=False)
 
 
 

@@ -17,11 +17,11 @@ ALGORITHMS = ("alg1", "alg2")
 
 
 
-AGREE_TOL = 1e-6     # rad: two selections are the same set (spec §7)
+AGREE_TOL = 1e-6     # rad: two selections are the same set
 
 
 
-JUMP_THRESHOLD = 0.5  # rad: a step between samples larger than this is a jump (spec §7, assumption)
+JUMP_THRESHOLD = 0.5  # rad: a step between samples larger than this is a jump (assumption)
 
 
 

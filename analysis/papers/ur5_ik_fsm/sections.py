@@ -6,20 +6,21 @@ import pandas as pd
 
 from analysis.core.compute_time import compute_time_section, machine_of
 from analysis.core.metrics import metric_value
+from analysis.core.sections import Section, Table
 from analysis.papers.ur5_ik_fsm.metrics import ALGORITHMS
 
 
-def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]:
+def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]:
     sections = []
     tables = metrics.get("tables")
     if tables is not None and "sequential" in set(tables["run_id"]):
         rows = [{"test": k, **{f"diff Alg {a[-1]} [rad]": metric_value(tables, "sequential", f"{a}.test{k}.diff")
                                for a in ALGORITHMS},
                  "same set": bool(metric_value(tables, "sequential", f"agreement.test{k}"))} for k in range(1, 11)]
-        sections.append("## Sequential variant (our extension)\n\nThe 10 poses in order, each algorithm starting "
-                        "from its own previous selection instead of 0. Agreement: "
-                        f"{metric_value(tables, 'sequential', 'agreement.count'):.0f}/10.\n\n"
-                        + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".4f"))
+        sections.append(Section(
+            "Sequential variant (our extension)", "The 10 poses in order, each algorithm starting from its own "
+            f"previous selection instead of 0. Agreement: {metric_value(tables, 'sequential', 'agreement.count'):.0f}"
+            "/10.", Table(pd.DataFrame(rows), ".4f"), category="trajectories"))
     paths = metrics.get("singular-paths")
     if paths is not None:
         per_run = paths[paths["metric"].isin(["max_joint_jump", "jumps", "branch_switches", "rejected_samples",
@@ -32,13 +33,13 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
                                       "max_joint_jump": "max jump [rad]", "max_joint_error": "max joint err [rad]",
                                       "max_flange_rotation_error": "max flange rot err [rad]"})
         agree = paths[paths["metric"] == "agreement"].set_index("run_id")["value"]
-        sections.append(
-            "## Singular paths (our extension, spec §6 ii)\n\nIK at 500 Hz along each flange path, previous = last "
-            "selection; then executed by the MuJoCo UR5 (joint PD + gravity compensation at 1 kHz). 'near' passes "
-            "0.1 mm from the singular pose, 'through' puts a sample on it. A jump is a step > 0.5 rad between "
-            "samples.\n\n" + table.reset_index().to_markdown(index=False, floatfmt=".4g")
-            + "\n\nAgreement of the two algorithms per path (fraction of samples with the same set):\n\n"
-            + agree.to_frame("agreement").reset_index().to_markdown(index=False, floatfmt=".3f"))
+        sections.append(Section(
+            "Singular paths (our extension)", "IK at 500 Hz along each flange path, previous = last selection; then "
+            "executed by the MuJoCo UR5 (joint PD + gravity compensation at 1 kHz). 'near' passes 0.1 mm from the "
+            "singular pose, 'through' puts a sample on it. A jump is a step > 0.5 rad between samples.",
+            Table(table, ".4g", index=True),
+            "Agreement of the two algorithms per path (fraction of samples with the same set):",
+            Table(agree.to_frame("agreement"), ".3f", index=True), category="trajectories"))
     ct = metrics.get("compute-time")
     if ct is not None and not ct.empty:
         rows = [(f"Algorithm {name[3]}" + (" (batched, per pose)" if "batch" in name else " (per call)"), name,
