@@ -9,16 +9,20 @@ from analysis.core.figures import Figures
 from analysis.core.metrics import MetricTable
 from analysis.papers.gripper_force_control.figures import _cycle_figure, _sag_figure, _steady_figure, _surface_figure
 from analysis.papers.gripper_force_control.metrics import (
+    OURS,
     SAG_CASES,
     SAG_WINDOW,
     STEADY_BELOW,
     SURFACE_WINDOW,
     _config,
+    competitor_ratios,
     cycle_times,
+    error_ratios,
     grasp_forces,
     motion_window,
     simulated_speed,
     slug,
+    tomato_force_limit,
     window_stats,
 )
 from pipeline.core.runlog import Run
@@ -69,6 +73,8 @@ def analyze_force_error_surface(runs: list[Run], figures: Figures) -> pd.DataFra
         m.add("surface", "force_error.max_at_epsilon", top["epsilon"], "rad/s^2")
         m.add("surface", "force_error.min", grid["max_error"].min(), "N")
         m.add("surface", "points", len(grid), "count")
+        for metric, (value, unit) in error_ratios(top["max_error"]).items():
+            m.add("surface", metric, value, unit)
         middle = np.median(np.unique(grid["omega"]))
         if (grid["omega"] > middle).any():
             low = grid[grid["omega"] <= middle]["max_error"].max()
@@ -83,7 +89,10 @@ def analyze_pick_and_place(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     for run in runs:
         start, end = motion_window(run)
-        m.add_run(run, cycle_times(run) | window_stats(run, start, end) | simulated_speed(run))
+        times, rotation = cycle_times(run), window_stats(run, start, end)
+        m.add_run(run, times | rotation | simulated_speed(run)
+                  | competitor_ratios(times["finger_speed.max"][0], times["closing_time"][0])
+                  | {"tomato.force_limit": tomato_force_limit(rotation["force_error.max"][0])})
     _cycle_figure(runs, figures)
     return m.frame()
 
@@ -116,29 +125,13 @@ def analyze_tables(runs: list[Run], figures: Figures) -> pd.DataFrame:
         rows = run["/tables"]
         values = {}
         speed = rows[rows["table"] == "table3"].set_index("gripper")["value.finger_speed"]
-        ours = speed["Proposed gripper v.1"]
-        ratios = (ours / speed.drop("Proposed gripper v.1"))
-        values |= {f"table3.{slug(g)}.ratio": (r, "ratio") for g, r in ratios.items()}
-        electric = ratios.drop([g for g in ratios.index if "pneumatic" in g])
-        values |= {"table3.ratio_min": (electric.min(), "ratio"), "table3.ratio_max": (electric.max(), "ratio")}
-        error = rows[rows["table"] == "table4"].set_index("gripper")["value.max_force_error"]
-        ours = error["Proposed gripper v.1"]
-        ratios = error.drop("Proposed gripper v.1") / ours
-        values |= {f"table4.{slug(g)}.ratio": (r, "ratio") for g, r in ratios.items()}
-        values |= {"table4.ratio_min": (ratios.min(), "ratio"), "table4.ratio_max": (ratios.max(), "ratio")}
-        table5 = rows[rows["table"] == "table5"].set_index("gripper")
-        ours = table5.loc["Proposed gripper v.1", "value.time_max"]
-        # the ONROBOT grippers whose closing time depends on the force (RG2, RG6): their low-force times
-        force_dependent = table5[table5.index.str.startswith("ONROBOT")
-                                 & (table5["value.time_max"] > table5["value.time_min"])]
-        slow = force_dependent["value.time_max"] / ours
-        values |= {"table5.onrobot_slowdown_max": (slow.max(), "ratio"),
-                   "table5.onrobot_slowdown_min": (slow.min(), "ratio")}
+        # the paper's own arithmetic (consistency): its printed speed over each competitor's
+        values |= {f"table3.{slug(g)}.printed_arithmetic": (speed[OURS] / v, "ratio")
+                   for g, v in speed.drop(OURS).items()}
         text = rows[rows["table"] == "text"].set_index("gripper")["value.value"]
         cycle = 2 * text["open_close_time"] + text["lift_rotate_time"]
         values |= {"text.cycle_time": (cycle, "s"), "text.rate": (60.0 / text["cycle_time"], "1/min"),
-                   "text.tomato_force_limit": (text["damage_force_min"] / text["safety_factor"]
-                                               - text["force_error"], "N")}
+                   "text.tomato_force_limit": tomato_force_limit(text["force_error"])}
         model = run["/model"].iloc[0]
         values |= {f"model.{k.removeprefix('value.')}": (float(v), "") for k, v in model.items()
                    if k.startswith("value.")}

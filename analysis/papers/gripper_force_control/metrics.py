@@ -5,15 +5,19 @@ from __future__ import annotations
 import re
 
 import numpy as np
+import pandas as pd
+import yaml
 
 from analysis.core.errors import error_stats, force_error_stats
+from analysis.core.targets import paper_value
+from pipeline.core.experiment import CONF_DIR
 from pipeline.core.runlog import Run
 
-SAG_WINDOW = 0.1        # s after the rotation's set point stops: Fig. 8's sag window (spec §7)
+SAG_WINDOW = 0.1        # s after the rotation's set point stops: Fig. 8's sag window
 
 
 
-SURFACE_WINDOW = 0.2    # s after the backward rotation: Fig. 9's error window (spec §7)
+SURFACE_WINDOW = 0.2    # s after the backward rotation: Fig. 9's error window
 
 
 
@@ -21,7 +25,7 @@ SETTLED = 0.01          # a rotation is done when the gripper stays within 1 % o
 
 
 
-STEADY_BELOW = 0.5      # N, "in most of the cases it was below 0.5 N" (Fig. 7b)
+STEADY_BELOW = paper_value("gripper-force-control", "F7.most")   # N, "in most of the cases it was below" (Fig. 7b)
 
 
 
@@ -113,3 +117,47 @@ def cycle_times(run: Run) -> dict[str, tuple[float, str]]:
 
 def slug(name: str) -> str:
     return re.sub(r"[^a-z0-9]+", "-", name.lower()).strip("-")
+
+
+SLUG = "gripper-force-control"
+OURS = "Proposed gripper v.1"
+
+
+def datasheets() -> dict[str, pd.DataFrame]:
+    """Tables 3-5 and the tomato text's inputs as the paper prints them (the `tables` experiment's config):
+    table name -> frame indexed by gripper. The simulated values are compared with these."""
+    tables = yaml.safe_load((CONF_DIR / "experiment" / "gripper-force-control" / "tables.yaml").read_text())
+    return {name: pd.DataFrame(t["rows"], index=t["columns"]).T for name, t in tables["scenario"]["tables"].items()}
+
+
+def competitor_ratios(finger_speed: float, closing_time: float) -> dict[str, tuple[float, str]]:
+    """The simulated finger speed over each competitor's datasheet speed (Table 3), and the ONROBOT
+    grippers' low-force gripping times over the simulated closing time (Sect. 5 on Table 5)."""
+    sheets = datasheets()
+    speed = sheets["table3"]["finger_speed"].drop(OURS)
+    ratios = finger_speed / speed
+    values = {f"table3.{slug(g)}.ratio": (r, "ratio") for g, r in ratios.items()}
+    electric = ratios.drop([g for g in ratios.index if "pneumatic" in g])
+    values |= {"table3.ratio_min": (electric.min(), "ratio"), "table3.ratio_max": (electric.max(), "ratio")}
+    table5 = sheets["table5"].drop(OURS)
+    # the ONROBOT grippers whose gripping time depends on the force (RG2, RG6): their low-force times
+    force_dependent = table5[table5.index.str.startswith("ONROBOT") & (table5["time_max"] > table5["time_min"])]
+    slow = force_dependent["time_max"] / closing_time
+    values |= {"table5.onrobot_slowdown_max": (slow.max(), "ratio"),
+               "table5.onrobot_slowdown_min": (slow.min(), "ratio")}
+    return values
+
+
+def error_ratios(force_error: float) -> dict[str, tuple[float, str]]:
+    """Each competitor's datasheet force error over the simulated maximum force error (Table 4)."""
+    error = datasheets()["table4"]["max_force_error"].drop(OURS)
+    ratios = error / force_error
+    return ({f"table4.{slug(g)}.ratio": (r, "ratio") for g, r in ratios.items()}
+            | {"table4.ratio_min": (ratios.min(), "ratio"), "table4.ratio_max": (ratios.max(), "ratio")})
+
+
+def tomato_force_limit(force_error: float) -> tuple[float, str]:
+    """Sect. 5's argument with a given force error: the tomato's damage force over the safety factor, minus
+    the error; F_set = 8.2 N is safe if it is at most this."""
+    text = datasheets()["text"]["value"]
+    return text["damage_force_min"] / text["safety_factor"] - force_error, "N"

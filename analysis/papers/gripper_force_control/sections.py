@@ -8,9 +8,10 @@ import numpy as np
 import pandas as pd
 
 from analysis.core.metrics import metric_value
+from analysis.core.sections import Section, Table
 
 
-def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]:
+def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]:
     sections = []
     sag = metrics.get("force-sag")
     if sag is not None and not sag.empty:
@@ -23,13 +24,12 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
         pairs = sorted(set(sag.loc[sag["metric"] == "plants.max_force_difference", "run_id"]))
         agree = [{"case": c, "max |F_mujoco − F_lumped| [N]": metric_value(sag, c, "plants.max_force_difference"),
                   "RMS [N]": metric_value(sag, c, "plants.rms_force_difference")} for c in pairs]
-        sections.append(
-            "## Fig. 8: force sag, every run\n\nF_set = 5 N, 40° at ω_max = 5.9 rad/s, ε_max = 73.3 rad/s²; the "
+        sections.append(Section(
+            "Fig. 8: force sag, every run", "F_set = 5 N, 40° at ω_max = 5.9 rad/s, ε_max = 73.3 rad/s²; the "
             "window runs from the rotation's start to 0.1 s after its set point stops. `coupling_eq9` runs a plant "
-            "with k_g = 1 + g_ps (eq. 9); `ff_printed` the feed-forward gains as eq. (9) prints them.\n\n"
-            + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".3f")
-            + "\n\nThe two plants (MuJoCo contact force vs the lumped pad force):\n\n"
-            + pd.DataFrame(agree).to_markdown(index=False, floatfmt=".4f"))
+            "with k_g = 1 + g_ps (eq. 9); `ff_printed` the feed-forward gains as eq. (9) prints them.",
+            Table(pd.DataFrame(rows), ".3f"), "The two plants (MuJoCo contact force vs the lumped pad force):",
+            Table(pd.DataFrame(agree), ".4f"), category="force errors"))
     surface = metrics.get("force-error-surface")
     if surface is not None and not surface.empty:
         points = surface[surface["run_id"] != "surface"].pivot(index="run_id", columns="metric", values="value")
@@ -37,8 +37,8 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
             grid = points.pivot_table(index="omega", columns="epsilon", values="force_error.max")
             grid.index = [f"ω = {w:g}" for w in grid.index]
             grid.columns = [f"ε = {e:g}" for e in grid.columns]
-            sections.append("## Fig. 9: max |F_f − F_set| [N] per grid point (ω in rad/s, ε in rad/s²)\n\n"
-                            + grid.to_markdown(floatfmt=".3f"))
+            sections.append(Section("Fig. 9: max |F_f − F_set| [N] per grid point (ω in rad/s, ε in rad/s²)",
+                                    Table(grid, ".3f", index=True), category="force errors"))
     pnp = metrics.get("pick-and-place")
     if pnp is not None and not pnp.empty:
         names = {"closing_time": "closing [ms]", "rotation_time": "rotation 45° [ms]",
@@ -50,30 +50,30 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
         for col in ("closing_time", "rotation_time", "rotation_profile_time", "opening_time", "cycle_time"):
             if col in table:
                 table[col] *= 1e3
-        sections.append("## Pick and place (tomato, F_set = 8.2 N, 98 mm travel, 45°)\n\nPaper: open/close 92 ms, "
-                        "lift + rotate 45° 130 ms, cycle 314 ms (191 per minute).\n\n"
-                        + table.rename(columns=names).reset_index().to_markdown(index=False, floatfmt=".3g"))
+        sections.append(Section("Pick and place (tomato, F_set = 8.2 N, 98 mm travel, 45°)",
+                                "Paper: open/close 92 ms, lift + rotate 45° 130 ms, cycle 314 ms (191 per minute).",
+                                Table(table.rename(columns=names), ".3g", index=True), category="trajectories"))
     mc = metrics.get("steady-state")
     if mc is not None and not mc.empty:
         forces = sorted({float(x.rsplit("F", 1)[1]) for x in mc["metric"] if x.startswith("steady_error.max.F")})
         rows = [{"F_set [N]": f, "max |error| [N]": metric_value(mc, "grasps", f"steady_error.max.F{f:g}"),
                  "mean error [N]": metric_value(mc, "grasps", f"steady_error.mean.F{f:g}")} for f in forces]
-        sections.append(
-            "## Fig. 7 stand-in: Monte-Carlo steady-state error (not the hardware result)\n\n"
+        sections.append(Section(
+            "Fig. 7 stand-in: Monte-Carlo steady-state error (not the hardware result)",
             f"{metric_value(mc, 'grasps', 'grasps'):.0f} grasps on the lumped plant, closing from a random 2-20 mm gap "
             "with M1's Coulomb friction drawn from 0.5-1.5 × the calibrated value; error = mean force over the "
             "last 50 ms − F_set. Paper (strain gauge, 50 grasps per set point): never above 0.8 N, mostly below "
             f"0.5 N. Here: max {metric_value(mc, 'grasps', 'steady_error.max'):.2f} N, "
-            f"{100 * metric_value(mc, 'grasps', 'steady_error.fraction_below_0.5N'):.0f} % below 0.5 N.\n\n"
-            + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".3f"))
+            f"{100 * metric_value(mc, 'grasps', 'steady_error.fraction_below_0.5N'):.0f} % below 0.5 N.",
+            Table(pd.DataFrame(rows), ".3f"), category="force errors"))
     tables = metrics.get("tables")
     if tables is not None and not tables.empty:
         model = tables[tables["metric"].str.startswith("model.")]
-        sections.append("## Model constants (derived from Sect. 5's parameters)\n\n"
-                        + model.assign(metric=model["metric"].str.removeprefix("model."))[["metric", "value"]]
-                        .to_markdown(index=False, floatfmt=".5g")
-                        + "\n\nBandwidths in rad/s, times in s, speeds in m/s, K_eps in A/(rad/s²), "
-                        "K_omega in V/(rad/s), force_per_amp in N/A.")
+        sections.append(Section(
+            "Model constants (derived from Sect. 5's parameters)",
+            Table(model.assign(metric=model["metric"].str.removeprefix("model."))[["metric", "value"]], ".5g"),
+            "Bandwidths in rad/s, times in s, speeds in m/s, K_eps in A/(rad/s²), K_omega in V/(rad/s), "
+            "force_per_amp in N/A."))
     if "wall_time_s" in runs:
         speed = [{"experiment": e, "runs": len(g), "wall time [s]": g["wall_time_s"].sum()}
                  for e, g in runs.groupby("experiment")]
@@ -89,9 +89,8 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
                     per_plant.append({"plant": plant, "wall s per simulated s (median)": part.median()})
         machine = json.loads(runs["machine"].dropna().iloc[0]) if "machine" in runs and runs["machine"].notna().any() \
             else {}
-        sections.append("## Simulation cost (not in the paper)\n\n50 µs ticks, the drive in Python, measured on "
-                        f"{machine.get('cpu', 'an unknown machine')}.\n\n"
-                        + pd.DataFrame(speed).to_markdown(index=False, floatfmt=".2f")
-                        + ("\n\n" + pd.DataFrame(per_plant).to_markdown(index=False, floatfmt=".3f")
-                           if per_plant else ""))
+        sections.append(Section(
+            "Simulation cost (not in the paper)",
+            f"50 µs ticks, the drive in Python, measured on {machine.get('cpu', 'an unknown machine')}.",
+            Table(pd.DataFrame(speed), ".2f"), *([Table(pd.DataFrame(per_plant), ".3f")] if per_plant else [])))
     return sections
