@@ -22,7 +22,7 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
                 "law v = v0 + A·w (1), the error-reduction condition dᵀ(v0 + A·w) < 0 (2) and the abstract's claim "
                 "that an admittance satisfying the conditions at a finite number of configurations of a bounded "
                 "contact state satisfies them in between. Every result beyond that (the conditions themselves, "
-                "proofs, examples) is **not reproducible**. The runs are the spec's demonstrator: a frictionless, "
+                "proofs, examples) is **not reproducible**. The runs are our demonstrator: a frictionless, "
                 "quasi-static square peg in a square hole in the two-point contact state (a tip vertex on one wall, "
                 "the opposite rim against the peg), planar and spatial, with condition (2) itself checked at the "
                 "corners of a box of configurations and on a dense interior sample."]

@@ -17,7 +17,7 @@ XYZ = ("x", "y", "z")
 
 
 
-ARRIVAL_POSITION = 1e-3            # m   (spec §7.7)
+ARRIVAL_POSITION = 1e-3            # m  
 
 
 
@@ -25,7 +25,7 @@ ARRIVAL_ANGLE = np.deg2rad(0.5)    # rad
 
 
 
-FINAL_WINDOW = 0.5                 # s: "final error" = mean over the last 0.5 s (spec §7.2)
+FINAL_WINDOW = 0.5                 # s: "final error" = mean over the last 0.5 s
 
 
 

@@ -10,7 +10,7 @@ from analysis.core.errors import error_stats
 from pipeline.core.runlog import Run
 from pipeline.papers.partial_lagrangian.chain import from_config, gravity_torque
 
-STEADY_WINDOW = 1.0      # s: steady state = mean over the last second (spec §7)
+STEADY_WINDOW = 1.0      # s: steady state = mean over the last second
 
 
 
@@ -18,11 +18,11 @@ SETTLED_SPEED = 1e-2     # rad/s or m/s: settled if every controlled |q̇| stays
 
 
 
-SETTLING_BAND = 0.02     # settling time: last entry into ±2 % of the step (spec §7)
+SETTLING_BAND = 0.02     # settling time: last entry into ±2 % of the step
 
 
 
-SLOPE_FROM = 3           # log-log slopes fitted over n = 3..10 (spec §7)
+SLOPE_FROM = 3           # log-log slopes fitted over n = 3..10
 
 
 
@@ -92,7 +92,7 @@ def _decay_rate(t: np.ndarray, q1: np.ndarray) -> float:
 
 def _linear_decay_rate(config: dict) -> float:
     """Small swings of one link about the hanging rest decay at c/(2 m l²), with the generalized damping
-    c = d l² of the Cartesian damper or c = d of the joint damper (spec §8.4)."""
+    c = d l² of the Cartesian damper or c = d of the joint damper."""
     system = config["system"]
     d, m, length = (system["links"][key][0] for key in ("damping", "mass", "length"))
     c = d * length ** 2 if system["damping_model"] == "cartesian" else d
@@ -120,7 +120,7 @@ def energy_scale(config: dict, n: int) -> float:
 
 
 def static_equilibrium(config: dict, n: int, reference: np.ndarray, kp: np.ndarray) -> np.ndarray:
-    """The rest posture of the PD law without gravity compensation: Kp (r − q) = ∂P/∂q (spec §8.5), with
+    """The rest posture of the PD law without gravity compensation: Kp (r − q) = ∂P/∂q, with
     the gravity torque from statics (not from either dynamics model); solved from q = r."""
     chain = from_config(config["system"], n)
     return fsolve(lambda q: kp * (reference - q) - gravity_torque(chain, q), reference, xtol=1e-12)

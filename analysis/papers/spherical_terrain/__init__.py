@@ -1,5 +1,5 @@
 """Analysis of `spherical-terrain`: convergence time, steady-state and vertex errors, control effort and tilt
-saturation of every tracking run (spec §7); the paper's Figs. 6-12 regenerated; the gain/start sweep
+saturation of every tracking run; the paper's Figs. 6-12 regenerated; the gain/start sweep
 tabulated from whatever sweep runs are on disk; and the physics check (MuJoCo vs the no-slip model).
 """
 

@@ -36,7 +36,7 @@ def analyze_paths(runs: list[Run], figures: Figures) -> pd.DataFrame:
     _controls(by_case, "rt", "Fig. 11 regenerated: RT-SR control signals", figures, "fig11-rt-controls")
     _controls(by_case, "rs", "Fig. 12(a) regenerated: RS-SR control signals", figures, "fig12a-rs-controls")
     _tilt(by_case, figures, "fig12b-rs-tilt")
-    _errors(by_case, "Tracking error, corrected equations (spec §7)", figures, "tracking-error")
+    _errors(by_case, "Tracking error, corrected equations", figures, "tracking-error")
     return m.frame()
 
 

@@ -20,15 +20,15 @@ COLOR = {"3r": "C0", "2r": "C1", "rt": "C2", "rs": "C3"}
 
 
 
-EPSILONS = (0.05, 0.1, 0.2)      # m, convergence thresholds (spec §7)
+EPSILONS = (0.05, 0.1, 0.2)      # m, convergence thresholds
 
 
 
-WINDOWS = (40.0, 30.0)           # s, start of the steady-state window (spec §7)
+WINDOWS = (40.0, 30.0)           # s, start of the steady-state window
 
 
 
-VERTEX_HALF_WIDTH = 5.0          # s, error near a vertex: within ±5 s of the target passing it (spec §7)
+VERTEX_HALF_WIDTH = 5.0          # s, error near a vertex: within ±5 s of the target passing it
 
 
 
