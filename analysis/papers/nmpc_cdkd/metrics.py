@@ -17,7 +17,7 @@ XYZ = ("x", "y", "z")
 
 
 
-ARRIVAL_POSITION = 1e-3            # m  
+ARRIVAL_POSITION = 1e-3            # m
 
 
 

@@ -115,7 +115,8 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
         sections.append(
             "## One link (Fig. 1): decay, and Listing A1 against the Lagrange equations\n\n"
             f"The free link's swing decays at {decay:.4f} 1/s over its later swings (linear theory {theory:.4f} 1/s, "
-            "paper.yaml errata). The listing's step stores about half of θ̈ as `acc` (I = acc.grad ≈ 2 m l²) and advances ω "
+            "paper.yaml errata). "
+            "The listing's step stores about half of θ̈ as `acc` (I = acc.grad ≈ 2 m l²) and advances ω "
             "by (acc_prev + acc)·dt, which nearly cancels: largest angle difference from the standard AD dynamics "
             f"{free:.3f}° (free) and {pd_:.3f}° (PD), same dt.")
     ct = metrics.get("compute-time")
