@@ -6,21 +6,22 @@ import pandas as pd
 
 from analysis.core.compute_time import compute_time_section, machine_of
 from analysis.core.metrics import metric_value
+from analysis.core.sections import Section, Table
 from analysis.papers.curve_discretization.metrics import CHECKS, PAPER_MACHINE, STAGES
 
 
-def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]:
+def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]:
     sections = []
     fig2 = metrics.get("bezier-fig2")
     if fig2 is not None and not fig2.empty:
         checks = fig2[fig2["metric"].isin([*CHECKS, "segment_length_error.max", "first_axis_angle",
                                            "shape_deviation.max", "evaluations"])]
         table = checks[checks["run_id"] != "all"].pivot(index="run_id", columns="metric", values="value")
-        sections.append(
-            "## Fig. 2 checks\n\nJoint points on the curve against three forward kinematics of the solved angles "
+        sections.append(Section(
+            "Fig. 2 checks", "Joint points on the curve against three forward kinematics of the solved angles "
             "(sequential rotations, the POE of eq. (8), MuJoCo's kinematics of the snake model), in curve units. "
-            "`shape_deviation` is the chord sag: the largest distance from the curve to the chain.\n\n"
-            + table.reset_index().to_markdown(index=False, floatfmt=".3g"))
+            "`shape_deviation` is the chord sag: the largest distance from the curve to the chain.",
+            Table(table, ".3g", index=True), category="trajectories"))
     fig3 = metrics.get("timing-fig3")
     if fig3 is not None and not fig3.empty:
         machine = machine_of(runs, "timing-fig3")
@@ -44,17 +45,16 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
                          **{f"{s} median [µs]": metric_value(fig3, rid, f"{s}.median") * 1e6 for s in STAGES},
                          "total p95 [µs]": metric_value(fig3, rid, "total.p95") * 1e6})
         fits = ", ".join(f"{s} {metric_value(fig3, 'all', f'{s}.exponent'):.2f}" for s in STAGES)
-        sections.append(
-            "## Time against the number of joints (Fig. 3)\n\n" + pd.DataFrame(rows).to_markdown(index=False,
-                                                                                                floatfmt=".3g")
-            + f"\n\nScaling exponents b of T ∝ N^b over 4-100 joints: {fits}; curve evaluations "
+        sections.append(Section(
+            "Time against the number of joints (Fig. 3)", Table(pd.DataFrame(rows), ".3g"),
+            f"Scaling exponents b of T ∝ N^b over 4-100 joints: {fits}; curve evaluations "
             f"{metric_value(fig3, 'all', 'evaluations.exponent'):.2f}. Affine fit of the angle stage: "
             f"{metric_value(fig3, 'all', 'angles.per_joint') * 1e9:.1f} ns per joint, R² "
             f"{metric_value(fig3, 'all', 'angles.linear_r2'):.3f}; the Theil–Sen line through the 10th percentiles "
             f"fits them within {metric_value(fig3, 'all', 'angles.p10.linear_spread'):.1%} (median |residual|). "
             "The search's cost is the forward march over the "
             "whole curve (about 1/dt evaluations whatever N) plus ~24 bisection steps per segment, so it grows "
-            "less than linearly from a large constant.")
+            "less than linearly from a large constant.", category="compute times"))
     snake = metrics.get("snake-gait")
     if snake is not None and not snake.empty:
         keys = {"shape_error.max": ("max shape error [mm]", 1e3), "shape_error.rms": ("rms shape error [mm]", 1e3),
@@ -65,13 +65,13 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
         gaits = [r for r in snake["run_id"].unique() if r != "all"]
         rows = [{"gait": g, **{label: metric_value(snake, g, k) * scale for k, (label, scale) in keys.items()}}
                 for g in gaits]
-        sections.append(
-            "## Snake robot in MuJoCo (the paper's motivating application)\n\nA 30-joint snake (15 segments of "
+        sections.append(Section(
+            "Snake robot in MuJoCo (the paper's motivating application)", "A 30-joint snake (15 segments of "
             "0.1 m, 14 2-DOF joints) on a floor; at 100 Hz the algorithm turns the travelling wave of that instant "
             "into joint references (warm-started from the previous step), hinge servos track them at 1 kHz. "
             "Shape error: the distance of each joint point of the body from the curve's joint point, the curve "
-            "placed on the body by the best rigid motion (least squares).\n\n"
-            + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".4g"))
+            "placed on the body by the best rigid motion (least squares).",
+            Table(pd.DataFrame(rows), ".4g"), category="trajectories"))
         if "lateral-undulation" in gaits:
             sections.append(compute_time_section(
                 "Compute time per control step (snake, lateral undulation)", snake, "lateral-undulation",

@@ -6,10 +6,11 @@ import pandas as pd
 
 from analysis.core.compute_time import compute_time_section, machine_of
 from analysis.core.metrics import metric_value
+from analysis.core.sections import Section, Table
 from analysis.papers.nmpc_cdkd.metrics import CASE_LABELS, TRAJECTORY_COLUMNS, _combo, paper_table3
 
 
-def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]:
+def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]:
     sections = []
     ct = metrics.get("compute-time")
     if ct is not None and not ct.empty:
@@ -27,19 +28,18 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
                          "failed solves": int(metric_value(ct, run_id, "solve.failures")),
                          "> 40 ms": metric_value(ct, run_id, "solve.over_control_horizon"),
                          "samples": int(metric_value(ct, run_id, "solve.samples"))})
-        table = pd.DataFrame(rows).to_markdown(index=False, floatfmt=".3g")
         ratio_rows = [{"movement": CASE_LABELS[c],
                        **{f"dec/full N{i + 1}": metric_value(ct, "table3", f"ratio.{c}.k{k}")
                                                        for i, k in enumerate((10, 20))},
                        "growth N1→N2 dec": metric_value(ct, "table3", f"growth.decomposed.{c}"),
                        "growth N1→N2 full": metric_value(ct, "table3", f"growth.full.{c}")} for c in CASE_LABELS]
-        sections.append(
-            "## Table 3: OCP solve time per step\n\nEach NMPC runs its own closed loop (ideal kinematic plant) over "
+        sections.append(Section(
+            "Table 3: OCP solve time per step", "Each NMPC runs its own closed loop (ideal kinematic plant) over "
             "the same seeded random point-to-point moves; the 12 loops advance one solve each in turn, so machine "
             "load falls on all alike. Every solve is one sample (wall time of the IPOPT call, warm-started); failed "
-            "solves are counted, not dropped. More moves: `scenario.moves=10`.\n\n" + table
-            + "\n\nRatios (paper: 0.13–0.20; growth dec +15/+22/+24 %, full +66/+37/+23 %):\n\n"
-            + pd.DataFrame(ratio_rows).to_markdown(index=False, floatfmt=".3f"))
+            "solves are counted, not dropped. More moves: `scenario.moves=10`.", Table(pd.DataFrame(rows), ".3g"),
+            "Ratios (paper: 0.13–0.20; growth dec +15/+22/+24 %, full +66/+37/+23 %):",
+            Table(pd.DataFrame(ratio_rows), ".3f"), category="compute times"))
         merged = ct.assign(metric=ct["run_id"] + "/" + ct["metric"], run_id="all")
         sections.append(compute_time_section(
             "Compute time per OCP step (median and p95)", merged, "all",
@@ -57,5 +57,5 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
         present = [c for c in TRAJECTORY_COLUMNS if c[0] in set(shown["metric"])]
         table = shown.pivot(index="run_id", columns="metric", values="value")
         table = pd.DataFrame({label: table[metric] * factor for metric, label, factor in present})
-        sections.append(f"## {title}\n\n" + table.reset_index().to_markdown(index=False, floatfmt=".4g"))
+        sections.append(Section(title, Table(table, ".4g", index=True), category="trajectories"))
     return sections

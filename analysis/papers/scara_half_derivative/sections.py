@@ -7,10 +7,11 @@ import pandas as pd
 
 from analysis.core.compute_time import compute_time_section, machine_of
 from analysis.core.metrics import metric_value
+from analysis.core.sections import Section, Table
 from analysis.papers.scara_half_derivative.metrics import PAPER_TABLE2, SCALE
 
 
-def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]:
+def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]:
     sections = []
     table2 = metrics.get("table2")
     if table2 is not None and not table2.empty:
@@ -25,9 +26,10 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
                     row[f"{name.upper()}"] = f"{value:.4g}" + (f" ({100 * pct:+.1f}%)" if np.isfinite(pct) else "")
                     row[f"paper {name.upper()}"] = printed
                 rows.append(row)
-            sections.append(f"## Table 2 as reproduced, K = {float(k):g} N/m (Exudyn closed chain)\n\nErrors in mm, "
-                            "torques in Nm, ISE in m²s; percentages vs KD. A KHD column of NaN means the run "
-                            "failed (unstable, see Runs).\n\n" + pd.DataFrame(rows).to_markdown(index=False))
+            sections.append(Section(f"Table 2 as reproduced, K = {float(k):g} N/m (Exudyn closed chain)",
+                                    "Errors in mm, torques in Nm, ISE in m²s; percentages vs KD. A KHD column of "
+                                    "NaN means the run failed (unstable, see Runs).", Table(pd.DataFrame(rows)),
+                                    category="tracking errors"))
         sections.append(compute_time_section(
             "Compute time per control step (not reported by the paper)", table2, "all",
             [("KD, eq. (11)", "controller.kd", "not reported"),
@@ -45,16 +47,17 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
                          "intercept [Ns^½/m]": metric_value(maps, sid, "locus.intercept"),
                          "paper (eq. 20)": "−9.44, 47,200"})
         lonely = [r["stiffness"] for r in rows if r["points"] < 2]
-        sections.append("## Equal-ICE locus fitted from the maps (Fig. 6, eq. 20)\n\nFor each hd_xyz of the grid, "
-                        "the d_xyz at which ICE equals KD's (linear interpolation along d), then a least-squares "
-                        "line through these points.\n\n" + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".5g")
-                        + ("\n\nWith a single point (" + ", ".join(lonely) + ") the only grid point at KD's ICE is KD "
-                           "itself: ICE grows in every direction around it on the grid, so this model has no "
-                           "equal-ICE line through KD to fit." if lonely else ""))
+        sections.append(Section(
+            "Equal-ICE locus fitted from the maps (Fig. 6, eq. 20)", "For each hd_xyz of the grid, the d_xyz at "
+            "which ICE equals KD's (linear interpolation along d), then a least-squares line through these points.",
+            Table(pd.DataFrame(rows), ".5g"),
+            ("With a single point (" + ", ".join(lonely) + ") the only grid point at KD's ICE is KD itself: ICE "
+             "grows in every direction around it on the grid, so this model has no equal-ICE line through KD to "
+             "fit." if lonely else ""), category="trajectories"))
     locus = metrics.get("locus")
     if locus is not None and not locus.empty:
         points = locus[locus["metric"].isin(["ise", "ice", "tau1.max", "tau2.max", "tau3.max"])]
         table = points.pivot_table(index=["k_xyz", "d_xyz", "hd_xyz"], columns="metric", values="value")
-        sections.append("## Along eq. (20) (Fig. 7)\n\n" + table.reset_index().sort_values(
-            ["k_xyz", "d_xyz"], ascending=[True, False]).to_markdown(index=False, floatfmt=".5g"))
+        sections.append(Section("Along eq. (20) (Fig. 7)", Table(table.reset_index().sort_values(
+            ["k_xyz", "d_xyz"], ascending=[True, False]), ".5g"), category="trajectories"))
     return sections

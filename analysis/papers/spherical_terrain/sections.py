@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pandas as pd
 
+from analysis.core.sections import Section, Table
 from analysis.papers.spherical_terrain.metrics import CLAIM_TIME, RUN_COLUMNS
 
 
@@ -20,7 +21,7 @@ def _run_table(frame: pd.DataFrame) -> pd.DataFrame:
 
 
 
-def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]:
+def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]:
     sections = []
     for name, title, text in (
             ("paths", "Tracking runs, corrected equations", "Default gains (all 1, k_e = 1 m), start at the "
@@ -32,7 +33,7 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
              "is a segment of the line y = x, traversed back and forth, so 'circle' here is that segment.")):
         frame = metrics.get(name)
         if frame is not None and not frame.empty:
-            sections.append(f"## {title}\n\n{text}\n\n" + _run_table(frame).to_markdown(index=False, floatfmt=".4g"))
+            sections.append(Section(title, text, Table(_run_table(frame), ".4g"), category="tracking errors"))
     sweep = metrics.get("sweep")
     if sweep is not None and not sweep.empty:
         params = [c for c in sweep.columns if c not in ("run_id", "metric", "value", "unit")]
@@ -42,10 +43,10 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
                                  dropna=False).reset_index()
         converged = sweep[sweep["metric"] == "claim.converges"]
         share = f"{int(converged['value'].sum())}/{len(converged)}"
-        sections.append(f"## Gain and start sweep\n\nEvery sweep run on disk ({len(converged)} runs; swept: "
+        sections.append(Section("Gain and start sweep", f"Every sweep run on disk ({len(converged)} runs; swept: "
                         f"{', '.join(params) or 'nothing'}). Runs with t_c(0.1 m) ≤ {CLAIM_TIME:g} s: {share}. "
-                        "An empty t_c means the error is above 0.1 m at the end.\n\n"
-                        + table.to_markdown(index=False, floatfmt=".4g"))
+                        "An empty t_c means the error is above 0.1 m at the end.",
+                                Table(table, ".4g"), category="tracking errors"))
     physics = metrics.get("physics-check")
     if physics is not None and not physics.empty:
         keep = {"paper_model_error.median": "vs paper model (median)", "rigid_model_error.median":
@@ -58,8 +59,8 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
                 "error_after_40s.max": "max e (t≥40) [m]"}
         table = physics[physics["metric"].isin(keep)].pivot(index="run_id", columns="metric", values="value")
         table = table.reindex(columns=[k for k in keep if k in table.columns]).rename(columns=keep)
-        sections.append(
-            "## Physics check (not in the paper)\n\nEach robot is a 2 kg ball on a MuJoCo height field of eq. "
+        sections.append(Section(
+            "Physics check (not in the paper)", "Each robot is a 2 kg ball on a MuJoCo height field of eq. "
             "(59), driven by torque-limited velocity actuators to the ω the paper's controller asks for, in closed "
             "loop at 100 Hz; the kinematic model runs beside it with the same controller and step. Model errors "
             "compare the ball's contact-point velocity v with two models fed the ball's measured ω, relative to "
@@ -68,6 +69,6 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
             "curvature term the paper drops "
             "(the difference of the two columns is the curvature effect; what remains against rigid rolling is "
             "slip, soft contact and the field's facets). Speed ratio: MuJoCo contact speed over the paper "
-            "model's, 5th/95th percentile while moving (the curvature bound is 1/(1 ± Rκ) = 0.86…1.19).\n\n"
-            + table.reset_index().to_markdown(index=False, floatfmt=".4g"))
+            "model's, 5th/95th percentile while moving (the curvature bound is 1/(1 ± Rκ) = 0.86…1.19).",
+            Table(table, ".4g", index=True)))
     return sections

@@ -7,10 +7,11 @@ import pandas as pd
 
 from analysis.core.compute_time import compute_time_section, machine_of
 from analysis.core.metrics import metric_value
+from analysis.core.sections import Section, Table
 from analysis.papers.src_joint.metrics import EULER
 
 
-def _joint_section(frame: pd.DataFrame) -> str:
+def _joint_section(frame: pd.DataFrame) -> Section:
     rows = []
     for run_id in sorted(set(frame["run_id"])):
         rows.append({"plant-model": run_id,
@@ -23,18 +24,20 @@ def _joint_section(frame: pd.DataFrame) -> str:
     contact = ("mujoco-corrected", ["contact.penetration_max", "contact.path_lower", "contact.path_mismatch",
                                     "plant.tangent_rate_error_mean", "plant.spin_rate_max"])
     details = ", ".join(f"{k} = {metric_value(frame, contact[0], k):.3g}" for k in contact[1])
-    return ("## Joint model against the plants (Figs. 8-10)\n\nThe paper's model is fed the Ω^B each plant "
+    return Section(
+        "Joint model against the plants (Figs. 8-10)", "The paper's model is fed the Ω^B each plant "
             "realised; 'printed-radius' runs eqs. (1), (5), (13)-(16) as printed, 'printed-sign' Table I's sign of "
             "Φ_v. "
-            "Mean |error| per XYZ Euler angle over 0-30 s (paper: [4.92, 0.01, 9.83]·10⁻⁴, unit not stated).\n\n"
-            + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".3g")
-            + f"\n\nMuJoCo contact (SI): {details}. What remains of the model–physics difference comes from the soft "
+            "Mean |error| per XYZ Euler angle over 0-30 s (paper: [4.92, 0.01, 9.83]·10⁻⁴, unit not stated).",
+        Table(pd.DataFrame(rows), ".3g"),
+        f"MuJoCo contact (SI): {details}. What remains of the model–physics difference comes from the soft "
             "contact (penetration): it falls with the square of the contact time constant `physics.solref[0]` "
-            "(tests/test_src_joint_control.py), which MuJoCo bounds below by 2 `physics.dt`.")
+            "(tests/test_src_joint_control.py), which MuJoCo bounds below by 2 `physics.dt`.",
+        category="tracking errors")
 
 
 
-def _reach_section(frame: pd.DataFrame) -> str:
+def _reach_section(frame: pd.DataFrame) -> Section:
     rows = []
     for run_id in sorted(set(frame["run_id"]) - {"random"}):
         rows.append({"run": run_id, "IK converged": bool(metric_value(frame, run_id, "ik.converged")),
@@ -46,18 +49,19 @@ def _reach_section(frame: pd.DataFrame) -> str:
                         for a in EULER},
                      "|Δp vs nominal| [mm]": metric_value(frame, run_id, "deviation.position") * 1e3,
                      "Δθ vs nominal [deg]": np.degrees(metric_value(frame, run_id, "deviation.orientation"))})
-    return ("## Reaching poses (Figs. 13-14) and the hardware stand-in\n\nIK from the Table II start, then the "
+    return Section(
+        "Reaching poses (Figs. 13-14) and the hardware stand-in", "IK from the Table II start, then the "
             "trolleys. Plants: `nominal` steers by the measured contact point ((53)-(55) online, FreeBOT-SIM); the "
             "others by wheel encoders only, with the EVA foam compressed by 1 mm and/or 2 % of the forward travel "
             "lost — the labelled stand-in for the paper's hardware errors (A: [4.17, −0.21, −4.19] mm, "
             "[1.07, −0.8, 1.45]°; B: [−3.51, 3.9, 1.47] mm, [0.13, 1.86, 0.52]°). 'Δ vs nominal' compares the "
             "final pose with FreeBOT-SIM's (the defects' own effect). A and B are not reachable with exact rolling "
-            "kinematics: the IK stops at the residual shown.\n\n"
-            + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".3g"))
+            "kinematics: the IK stops at the residual shown.",
+        Table(pd.DataFrame(rows), ".3g"), category="tracking errors")
 
 
 
-def _obstacle_section(frame: pd.DataFrame) -> str:
+def _obstacle_section(frame: pd.DataFrame) -> Section:
     rows = [{"case": run_id,
              **{f"min clearance {bar} [mm]": metric_value(frame, run_id, f"clearance.{bar}.min") * 1e3
                 for bar in ("bar1", "bar2")},
@@ -68,14 +72,15 @@ def _obstacle_section(frame: pd.DataFrame) -> str:
              "t(|e_p| < 1 mm) [s]": metric_value(frame, run_id, "time_to_1mm"),
              "max level-1 slack": metric_value(frame, run_id, "qp.slack_max")}
             for run_id in sorted(set(frame["run_id"]))]
-    return ("## Target C between the bars (Figs. 16-17)\n\nBars parallel to x through the Table II points, radius "
+    return Section(
+        "Target C between the bars (Figs. 16-17)", "Bars parallel to x through the Table II points, radius "
             "5 mm (assumed); dampers act below 40 mm with gain 0.5 s⁻¹ and keep 10 mm (the paper's safety distance). "
-            "`unconstrained` is the same loop without the dampers.\n\n"
-            + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".4g"))
+            "`unconstrained` is the same loop without the dampers.",
+        Table(pd.DataFrame(rows), ".4g"), category="trajectories")
 
 
 
-def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]:
+def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]:
     sections = []
     if metrics.get("joint-model") is not None and not metrics["joint-model"].empty:
         sections.append(_joint_section(metrics["joint-model"]))
