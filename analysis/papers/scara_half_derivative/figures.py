@@ -7,11 +7,13 @@ import pandas as pd
 from matplotlib import ticker
 
 from analysis.core.figures import Figures, plt
+from analysis.core.targets import paper_value
 from analysis.papers.scara_half_derivative.metrics import (
     AXES,
     CONTROLLER_COLORS,
     FULL_PLOT_STRIDE,
     KD_DAMPING,
+    SLUG,
     ZOOM,
     _stiffness_id,
 )
@@ -56,10 +58,15 @@ def _error_figures(k: float, controllers: dict[str, tuple[Run, dict]], figures: 
                       color=CONTROLLER_COLORS[name], label=name.upper())
             window = err.loc[peak - ZOOM[0]:peak + ZOOM[1]]
             zoom.plot(window.index, window, lw=1.1, color=CONTROLLER_COLORS[name])
+            printed = paper_value(SLUG, f"T2.e{axis}_max.{name}.k8e5")   # Table 2's max |e|, at ± on the plot
+            for ax in (full, zoom):
+                for sign in (1, -1):
+                    ax.axhline(sign * printed, color=CONTROLLER_COLORS[name], ls="--", lw=0.8, alpha=0.8)
+        full.plot([], [], "k--", lw=0.8, label="paper: max |e| (Table 2)")
         full.set_xlabel("time [s]")
         zoom.set_xlabel("time [s] (peak zone)")
         full.set_ylabel(f"e_{axis} [mm]")
-        full.legend(ncol=3)
+        full.legend(ncol=3, loc="center", bbox_to_anchor=(0.5, 0.75))   # between the traces and the paper lines
         fig.suptitle(f"Fig. {fig_number}: error e_{axis}, K = {k:g} N/m")
         figures.save(fig, f"fig{fig_number}-e{axis}-{_stiffness_id(k)}")
 

@@ -8,7 +8,7 @@ import pandas as pd
 from analysis.core.compute_time import compute_time_section, machine_of
 from analysis.core.metrics import metric_value
 from analysis.core.sections import Section, Table
-from analysis.papers.scara_half_derivative.metrics import PAPER_TABLE2, SCALE
+from analysis.papers.scara_half_derivative.metrics import SCALE, paper_table2
 
 
 def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]:
@@ -17,7 +17,7 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
     if table2 is not None and not table2.empty:
         for k in sorted({rid.rsplit("-k", 1)[1] for rid in table2["run_id"] if "-k" in rid}, key=float):
             rows = []
-            for metric, paper in PAPER_TABLE2.items():
+            for metric, paper in paper_table2().items():
                 scale = SCALE.get(metric.split(".")[0], 1.0)
                 row = {"index": metric}
                 for name, printed in zip(("kd", "kdhd", "khd"), paper, strict=True):
