@@ -6,18 +6,25 @@ import numpy as np
 import pandas as pd
 
 from analysis.core.errors import error_stats
-from analysis.core.figures import Figures, plt
+from analysis.core.figures import Figures
 from analysis.core.metrics import MetricTable
-from analysis.papers.spherical_terrain.figures import _controls, _errors, _paths_3d, _tilt, _xyz_vs_time
+from analysis.papers.spherical_terrain.figures import (
+    _controls,
+    _errors,
+    _paths_3d,
+    _physics_figure,
+    _sweep_figure,
+    _tilt,
+    _xyz_vs_time,
+)
 from analysis.papers.spherical_terrain.metrics import (
-    COLOR,
-    LABEL,
     MOVING,
     WINDOWS,
     _agility,
     _case,
     _per_run,
     _reference_metrics,
+    convergence_summary,
     convergence_time,
 )
 from pipeline.core.runlog import Run
@@ -25,7 +32,7 @@ from pipeline.core.runlog import Run
 
 def analyze_paths(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m, by_case, table = _per_run(runs)
-    for name, (value, unit) in (_reference_metrics(by_case) | _agility(table)).items():
+    for name, (value, unit) in (_reference_metrics(by_case) | _agility(table) | convergence_summary(table)).items():
         m.add("all", name, value, unit)
     _paths_3d(by_case, "circle", "Fig. 6 regenerated: circular path on the terrain", figures, "fig06-circle-3d")
     _paths_3d(by_case, "diamond", "Fig. 7 regenerated: diamond path on the terrain", figures, "fig07-diamond-3d")
@@ -59,19 +66,7 @@ def analyze_sweep(runs: list[Run], figures: Figures) -> pd.DataFrame:
         tc = tc.assign(case=tc["run_id"].str.split("__").str[0],
                        setting=tc[params].astype(str).agg(", ".join, axis=1))
         pivot = tc.pivot_table(index="case", columns="setting", values="value", aggfunc="first", dropna=False)
-        fig, ax = plt.subplots(figsize=(9, 3.6))
-        width = 0.8 / max(1, pivot.shape[1])
-        x = np.arange(len(pivot))
-        for j, setting in enumerate(pivot.columns):
-            values = pivot[setting].to_numpy(dtype=float)
-            ax.bar(x + j * width, np.nan_to_num(values, nan=0.0), width, label=setting)
-            ax.plot(x[np.isnan(values)] + j * width, np.full(np.isnan(values).sum(), 1.0), "kx")
-        ax.axhline(30.0, color="k", ls="--", lw=1)
-        ax.set_xticks(x + 0.4 - width / 2, pivot.index, rotation=30, fontsize=7)
-        ax.set_ylabel("t_c(0.1 m) [s]  (x: never)")
-        ax.set_title(f"Sweep over {', '.join(params)}")
-        ax.legend(fontsize=6, ncol=2)
-        figures.save(fig, "sweep-convergence-time")
+        _sweep_figure(pivot, params, figures)
     return frame
 
 
@@ -80,7 +75,7 @@ def analyze_physics(runs: list[Run], figures: Figures) -> pd.DataFrame:
     """The ball on the MuJoCo height field against the paper's no-slip model (eq. 31) and exact rigid
     rolling, both fed the ball's own measured ω; and closed-loop tracking against the kinematic model."""
     m = MetricTable()
-    fig, axes = plt.subplots(3, 1, figsize=(8, 7.5), sharex=True)
+    traces = []
     for run in runs:
         robot, _ = _case(run)
         phys = run["/physics"]
@@ -110,18 +105,8 @@ def analyze_physics(runs: list[Run], figures: Figures) -> pd.DataFrame:
             "tc_0.1": (convergence_time(t, e, 0.1), "s"),
             "kinematic.tc_0.1": (convergence_time(t, e_kin.to_numpy(), 0.1), "s"),
         })
-        axes[0].plot(t[moving], actual[moving] / paper[moving], ".", ms=1, color=COLOR[robot], label=LABEL[robot])
-        axes[1].semilogy(t, np.maximum(phys["value.slip_speed"], 1e-6), color=COLOR[robot], lw=0.6)
-        axes[2].semilogy(t, np.maximum(e, 1e-5), color=COLOR[robot], lw=0.9, label=f"{LABEL[robot]} MuJoCo")
-        axes[2].semilogy(e_kin.index, np.maximum(e_kin, 1e-5), color=COLOR[robot], lw=0.7, ls=":")
-    axes[0].set_ylabel("contact speed:\nMuJoCo / paper model")
-    axes[0].set_ylim(0.5, 1.5)
-    axes[0].legend(fontsize=7, markerscale=8)
-    axes[1].set_ylabel("slip speed [m/s]")
-    axes[2].set_ylabel("‖e_t‖ [m]\n(dotted: kinematic)")
-    axes[2].set_xlabel("time [s]")
-    fig.suptitle("Physics check: ball on a MuJoCo height field, the paper's controller in closed loop")
-    figures.save(fig, "physics-check")
+        traces.append((robot, t, moving, ratio, phys["value.slip_speed"], e, e_kin))
+    _physics_figure(traces, figures)
     return m.frame()
 
 

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from analysis.core.figures import Figures, plt
-from analysis.papers.spherical_terrain.metrics import COLOR, LABEL, _terrain
+from analysis.core.figures import Figures, paper_hline, paper_vline, plt
+from analysis.core.targets import paper_value
+from analysis.papers.spherical_terrain.metrics import COLOR, LABEL, SLUG, _terrain
 from pipeline.core.runlog import Run
 from pipeline.papers.spherical_terrain.kinematics import CosineTerrain
 from pipeline.papers.spherical_terrain.tracking import CLASSES
@@ -71,13 +72,25 @@ def _controls(runs: dict[str, Run], robot: str, title: str, figures: Figures, na
     if not series:
         return
     columns = [c for c in series[0][1].columns if c.startswith("value.")]
-    fig, axes = plt.subplots(len(columns), 1, figsize=(8, 2.2 * len(columns)), sharex=True)
-    for ax, column in zip(np.atleast_1d(axes), columns, strict=True):
-        for path, command in series:
-            ax.plot(command.index, command[column], lw=0.8, label=path)
-        ax.set_ylabel(column.removeprefix("value.").replace("_dot", " rate") + " [rad/s]")
-    np.atleast_1d(axes)[0].legend()
-    np.atleast_1d(axes)[-1].set_xlabel("time [s]")
+    # The pursuit law switches at the control rate: drawn as one line it fills a solid band of ink. One panel
+    # per path and rate, the raw command thin and light, its 1 s running mean on top.
+    fig, axes = plt.subplots(len(columns), len(series), figsize=(5 * len(series), 2.1 * len(columns)),
+                             sharex=True, sharey="row", squeeze=False)
+    for row, column in enumerate(columns):
+        for col, (path, command) in enumerate(series):
+            ax = axes[row, col]
+            values = command[column]
+            window = max(1, round(1.0 / float(np.median(np.diff(command.index)))))
+            ax.plot(command.index, values, lw=0.3, color=f"C{col}", alpha=0.35, label="command")
+            ax.plot(command.index, values.rolling(window, center=True, min_periods=1).mean(), lw=1.4,
+                    color=f"C{col}", label="1 s running mean")
+            if row == 0:
+                ax.set_title(path)
+            if col == 0:
+                ax.set_ylabel(column.removeprefix("value.").replace("_dot", " rate") + " [rad/s]")
+    axes[0, 0].legend(fontsize=7, loc="lower right")
+    for ax in axes[-1]:
+        ax.set_xlabel("time [s]")
     fig.suptitle(title)
     figures.save(fig, name)
 
@@ -114,10 +127,45 @@ def _errors(runs: dict[str, Run], title: str, figures: Figures, name: str) -> No
             e = run["/tracking_error"]["norm"]
             ax.semilogy(e.index, np.maximum(e, 1e-5), color=COLOR[robot], lw=0.9, label=LABEL[robot])
         ax.axhline(0.1, color="k", ls=":", lw=1)
-        ax.axvline(30.0, color="0.5", ls="--", lw=1)
+        paper_vline(ax, paper_value(SLUG, "converge.time"), label="paper: converges in ≈ 30 s")
         ax.set_title(path)
         ax.set_xlabel("time [s]")
-    axes[0].set_ylabel("‖e_t‖ [m]  (dotted: 0.1 m, dashed: 30 s)")
+    axes[0].set_ylabel("‖e_t‖ [m]  (dotted: 0.1 m)")
     axes[0].legend(fontsize=7)
     fig.suptitle(title)
     figures.save(fig, name)
+
+
+def _sweep_figure(pivot, params: list[str], figures: Figures) -> None:
+    """Convergence time of every case per swept setting (x: never within the run)."""
+    fig, ax = plt.subplots(figsize=(9, 3.6))
+    width = 0.8 / max(1, pivot.shape[1])
+    x = np.arange(len(pivot))
+    for j, setting in enumerate(pivot.columns):
+        values = pivot[setting].to_numpy(dtype=float)
+        ax.bar(x + j * width, np.nan_to_num(values, nan=0.0), width, label=setting)
+        ax.plot(x[np.isnan(values)] + j * width, np.full(np.isnan(values).sum(), 1.0), "kx")
+    paper_hline(ax, paper_value(SLUG, "converge.time"), label="paper: ≈ 30 s")
+    ax.set_xticks(x + 0.4 - width / 2, pivot.index, rotation=30, fontsize=7)
+    ax.set_ylabel("t_c(0.1 m) [s]  (x: never)")
+    ax.set_title(f"Sweep over {', '.join(params)}")
+    ax.legend(fontsize=6, ncol=2)
+    figures.save(fig, "sweep-convergence-time")
+
+
+def _physics_figure(traces: list, figures: Figures) -> None:
+    """Contact speed against the paper's model, slip, and tracking error against the kinematic model."""
+    fig, axes = plt.subplots(3, 1, figsize=(8, 7.5), sharex=True)
+    for robot, t, moving, ratio, slip, e, e_kin in traces:
+        axes[0].plot(t[moving], ratio, ".", ms=1, color=COLOR[robot], label=LABEL[robot])
+        axes[1].semilogy(t, np.maximum(slip, 1e-6), color=COLOR[robot], lw=0.6)
+        axes[2].semilogy(t, np.maximum(e, 1e-5), color=COLOR[robot], lw=0.9, label=f"{LABEL[robot]} MuJoCo")
+        axes[2].semilogy(e_kin.index, np.maximum(e_kin, 1e-5), color=COLOR[robot], lw=0.7, ls=":")
+    axes[0].set_ylabel("contact speed:\nMuJoCo / paper model")
+    axes[0].set_ylim(0.5, 1.5)
+    axes[0].legend(fontsize=7, markerscale=8)
+    axes[1].set_ylabel("slip speed [m/s]")
+    axes[2].set_ylabel("‖e_t‖ [m]\n(dotted: kinematic)")
+    axes[2].set_xlabel("time [s]")
+    fig.suptitle("Physics check: ball on a MuJoCo height field, the paper's controller in closed loop")
+    figures.save(fig, "physics-check")

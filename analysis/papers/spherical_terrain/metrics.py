@@ -12,6 +12,7 @@ from pipeline.papers.spherical_terrain.kinematics import CosineTerrain
 from pipeline.papers.spherical_terrain.paths import vertex_times
 from pipeline.papers.spherical_terrain.tracking import CLASSES
 
+SLUG = "spherical-terrain"
 LABEL = {"3r": "3R-SR", "2r": "2R-SR", "rt": "RT-SR", "rs": "RS-SR"}
 
 
@@ -130,6 +131,12 @@ def _agility(table: pd.DataFrame) -> dict[str, tuple[float, str]]:
             values[name] = (max(got["3r"], got["2r"]) / min(got["rt"], got["rs"]), "ratio")
     return values
 
+
+
+def convergence_summary(table: dict) -> dict[str, tuple[float, str]]:
+    """The median t_c(0.1 m) of the runs that converge (Sec. 6: 'in approximately 30 s')."""
+    tc = [v for (case, metric), v in table.items() if metric == "tc_0.1" and np.isfinite(v)]
+    return {"tc_0.1.median": (float(np.median(tc)), "s")} if tc else {}
 
 
 def _per_run(runs: list[Run]) -> tuple[MetricTable, dict[str, Run], dict]:
