@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from analysis.core.figures import Figures, plt
-from analysis.papers.src_joint.metrics import EULER, SIX, _bars
+from analysis.core.figures import Figures, paper_hline, plt
+from analysis.core.targets import paper_value
+from analysis.papers.src_joint.metrics import EULER, SIX, SLUG, _bars
 from pipeline.core.runlog import Run
 
 
@@ -19,6 +20,10 @@ def _joint_figures(plant: str, runs: dict[str, Run], figures: Figures, velocitie
         ax.plot(err.index, np.degrees(err[f"error.{axis}"]), label=axis)
     ax.set_xlabel("t [s]")
     ax.set_ylabel("rotation error [deg]")
+    peak = paper_value(SLUG, "V-A.peak")   # deg, the paper's bound on the peak (Fig. 9)
+    paper_hline(ax, peak, label=f"paper: |peak| < {peak:g}°")
+    paper_hline(ax, -peak, label=None)
+    ax.set_yscale("symlog", linthresh=1e-6)   # our error (~1e-5°) and the paper bound (0.02°) both readable
     ax.set_title(f"R(q_i) (corrected model) vs {label}: XYZ Euler angles of R_modelᵀ R", fontsize=8)
     ax.legend(fontsize=7)
     figures.save(fig, f"fig9-rotation-error-{plant}")
@@ -123,7 +128,7 @@ def _obstacle_figures(runs: dict[str, Run], figures: Figures) -> None:
                 every = check.iloc[::50]
                 ax.plot(every.index, every.filter(like=bar).min(axis=1) * 1e3, "o", ms=3, mfc="none", color=f"C{k}",
                         label=f"{bar}, MuJoCo mj_geomDistance")
-    ax.axhline(10.0, color="r", ls="--", lw=1, label="safety distance 0.01 m")
+    paper_hline(ax, paper_value(SLUG, "V-C.clearance.bar1", "mm"), label="paper: safety distance 10 mm")
     ax.set_xlabel("t [s]")
     ax.set_ylabel("closest distance [mm]")
     ax.legend(fontsize=7, ncol=2)

@@ -25,6 +25,7 @@ CONSISTENT = 0.01
 
 
 
+SLUG = "src-joint"
 EULER = ["X", "Y", "Z"]
 
 
