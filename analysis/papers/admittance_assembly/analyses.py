@@ -69,7 +69,6 @@ def analyze_corner_conditions(runs: list[Run], figures: Figures) -> pd.DataFrame
     return m.frame()
 
 
-
 def analyze_insertion(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     groups: dict[str, list[tuple[Run, dict]]] = {}
@@ -92,7 +91,6 @@ def analyze_insertion(runs: list[Run], figures: Figures) -> pd.DataFrame:
         runs_of_case = [(r, v) for group, items in groups.items() if group.startswith(case) for r, v in items]
         _insertion_figure(case, runs_of_case, figures)
     return m.frame()
-
 
 
 def analyze_mujoco_crosscheck(runs: list[Run], figures: Figures) -> pd.DataFrame:
@@ -132,7 +130,6 @@ def analyze_mujoco_crosscheck(runs: list[Run], figures: Figures) -> pd.DataFrame
         m.add_run(run, values)
         _mujoco_figure(run, names, t, f_meas, f_pred, settle, figures)
     return m.frame()
-
 
 
 ANALYSES = {"corner-conditions": analyze_corner_conditions, "insertion": analyze_insertion,

@@ -43,7 +43,6 @@ def _conditions_figure(run: Run, corners: pd.DataFrame, interior: pd.DataFrame, 
     figures.save(fig, f"{run.run_id}-conditions")
 
 
-
 def _insertion_figure(case: str, items: list[tuple[Run, dict]], figures: Figures) -> None:
     if not items:
         return
@@ -67,7 +66,6 @@ def _insertion_figure(case: str, items: list[tuple[Run, dict]], figures: Figures
     ax2.legend(fontsize=7)
     fig.suptitle(f"{case}: quasi-static insertions under v = v0 + A·w")
     figures.save(fig, f"{case}-insertions")
-
 
 
 def _mujoco_figure(run: Run, names: list[str], t, f_meas, f_pred, settle: float, figures: Figures) -> None:

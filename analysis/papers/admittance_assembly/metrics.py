@@ -10,17 +10,13 @@ from pipeline.core.runlog import Run
 CASES = ("planar", "spatial")
 
 
-
 FORCE = ["force_x", "force_y", "force_z"]
-
 
 
 TORQUE = ["torque_x", "torque_y", "torque_z"]
 
 
-
 CONTACT_FORCE_ON = 1e-3  # N: a hole feature carries force above this (contact-state agreement)
-
 
 
 def _scalars(run: Run, topic: str) -> pd.DataFrame:
@@ -28,10 +24,8 @@ def _scalars(run: Run, topic: str) -> pd.DataFrame:
     return frame.rename(columns=lambda c: c.removeprefix("value."))
 
 
-
 def _vectors(frame: pd.DataFrame, parts: list[str], name: str) -> np.ndarray:
     return frame[[f"{p}.{name}" for p in parts]].to_numpy()
-
 
 
 def _insertion_metrics(run: Run) -> dict:
@@ -59,7 +53,6 @@ def _insertion_metrics(run: Run) -> dict:
         "max_contact_force": (np.nanmax(forces) if forces.size else 0.0, "N"),
         "max_total_force": (np.linalg.norm(_vectors(wrench, FORCE, "peg"), axis=1).max(), "N"),
     }
-
 
 
 def _contact_forces(run: Run, topic: str) -> tuple[list[str], np.ndarray]:

@@ -17,7 +17,6 @@ def _pivot(frame: pd.DataFrame, metrics: dict[str, str], runs: list[str] | None 
     return table[[k for k in metrics if k in table]].rename(columns=metrics)
 
 
-
 def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]:
     sections = [Section("What can be reproduced",
                         "The paper's text ends inside Sec. I. What survives is the admittance "

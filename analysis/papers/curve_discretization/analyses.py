@@ -42,7 +42,6 @@ def analyze_bezier(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-
 def analyze_timing(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     rows = []
@@ -76,7 +75,6 @@ def analyze_timing(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-
 def analyze_snake(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     all_values = []
@@ -89,7 +87,6 @@ def analyze_snake(runs: list[Run], figures: Figures) -> pd.DataFrame:
         for key in ("realtime_ratio", "ratio.warm_cold_search"):
             m.add("all", key, max(v[key][0] for v in all_values), "ratio")
     return m.frame()
-
 
 
 ANALYSES = {"bezier-fig2": analyze_bezier, "timing-fig3": analyze_timing, "snake-gait": analyze_snake}

@@ -36,7 +36,6 @@ def _fig2(paper: Run, runs: list[Run], figures: Figures) -> None:
     figures.save(fig, "fig2-bezier-chain")
 
 
-
 def _fig3(table: pd.DataFrame, fits: dict, figures: Figures) -> None:
     n = table["joints"].to_numpy(float)
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
@@ -61,7 +60,6 @@ def _fig3(table: pd.DataFrame, fits: dict, figures: Figures) -> None:
     axes[1].set_title("angle stage, eqs. (16)-(17): linear in N", fontsize=9)
     axes[1].legend(fontsize=7)
     figures.save(fig, "fig3-time-vs-joints")
-
 
 
 def _snake_figure(run: Run, values: dict, figures: Figures) -> None:

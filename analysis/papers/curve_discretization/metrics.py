@@ -14,17 +14,13 @@ from pipeline.core.runlog import Run
 CHECKS = {"on_curve": "/chain/fk", "poe_on_curve": "/chain/poe", "mujoco_on_curve": "/chain/mujoco"}
 
 
-
 STAGES = ("search", "angles", "total")
-
 
 
 LINEAR_SPREAD = 0.05  # "increases linearly" (our rule for Fig. 3): a robust line fits within 5 % of the median time
 
 
-
 PAPER_MACHINE = "MATLAB 7.1, Apple Mac Pro (2008), OS X 10.4.11, 3 GB RAM"
-
 
 
 def xyz(frame: pd.DataFrame) -> np.ndarray:
@@ -34,7 +30,6 @@ def xyz(frame: pd.DataFrame) -> np.ndarray:
                             for a in "xyz"])
 
 
-
 def polyline_distance(points: np.ndarray, vertices: np.ndarray) -> np.ndarray:
     """Distance of each point to the polyline through `vertices`."""
     a, b = vertices[:-1], vertices[1:]
@@ -42,7 +37,6 @@ def polyline_distance(points: np.ndarray, vertices: np.ndarray) -> np.ndarray:
     s = np.einsum("kij,ij->ki", points[:, None] - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300)
     nearest = a + np.clip(s, 0.0, 1.0)[..., None] * ab
     return np.linalg.norm(points[:, None] - nearest, axis=2).min(axis=1)
-
 
 
 def _chain_values(run: Run) -> dict:
@@ -72,12 +66,10 @@ def _chain_values(run: Run) -> dict:
     return values
 
 
-
 def per_call(run: Run, name: str) -> np.ndarray:
     """Seconds per call of one timed algorithm from a run's /compute_time."""
     ct = run["/compute_time"]
     return (ct[f"seconds.{name}"] / ct[f"calls.{name}"]).dropna().to_numpy()
-
 
 
 def fit_scaling(joints: np.ndarray, seconds: np.ndarray) -> dict[str, float]:
@@ -91,7 +83,6 @@ def fit_scaling(joints: np.ndarray, seconds: np.ndarray) -> dict[str, float]:
     slope, intercept, _, _ = theilslopes(seconds, joints)
     spread = np.median(np.abs(seconds - (intercept + slope * joints))) / np.median(seconds)
     return {"exponent": exponent, "per_joint": c, "intercept": a, "r2": r2, "robust_slope": slope, "spread": spread}
-
 
 
 def _gait_values(run: Run) -> dict:

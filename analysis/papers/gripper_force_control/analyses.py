@@ -52,7 +52,6 @@ def analyze_force_sag(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return frame
 
 
-
 def analyze_force_error_surface(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     points = []
@@ -84,7 +83,6 @@ def analyze_force_error_surface(runs: list[Run], figures: Figures) -> pd.DataFra
     return m.frame()
 
 
-
 def analyze_pick_and_place(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     for run in runs:
@@ -95,7 +93,6 @@ def analyze_pick_and_place(runs: list[Run], figures: Figures) -> pd.DataFrame:
                   | {"tomato.force_limit": tomato_force_limit(rotation["force_error.max"][0])})
     _cycle_figure(runs, figures)
     return m.frame()
-
 
 
 def analyze_steady_state(runs: list[Run], figures: Figures) -> pd.DataFrame:
@@ -118,7 +115,6 @@ def analyze_steady_state(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-
 def analyze_tables(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     for run in runs:
@@ -137,7 +133,6 @@ def analyze_tables(runs: list[Run], figures: Figures) -> pd.DataFrame:
                    if k.startswith("value.")}
         m.add_run(run, values)
     return m.frame()
-
 
 
 ANALYSES = {"force-sag": analyze_force_sag, "force-error-surface": analyze_force_error_surface,

@@ -42,7 +42,6 @@ def _sag_figure(runs: list[Run], figures: Figures) -> None:
     figures.save(fig, "fig8-force-sag")
 
 
-
 def _surface_figure(grid: pd.DataFrame, figures: Figures) -> None:
     table = grid.pivot_table(index="epsilon", columns="omega", values="max_error")
     bound = paper_value(SLUG, "F9.max")
@@ -95,7 +94,6 @@ def _cycle_figure(runs: list[Run], figures: Figures) -> None:
         ax.legend(fontsize=7)
     axes[0].set_title("Pick and place: close at 8.2 N, turn 45°, open (MuJoCo)")
     figures.save(fig, "pick-and-place")
-
 
 
 def _steady_figure(f_set: np.ndarray, error: np.ndarray, figures: Figures) -> None:

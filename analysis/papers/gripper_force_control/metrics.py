@@ -16,21 +16,16 @@ from pipeline.core.runlog import Run
 SAG_WINDOW = 0.1        # s after the rotation's set point stops: Fig. 8's sag window
 
 
-
 SURFACE_WINDOW = 0.2    # s after the backward rotation: Fig. 9's error window
-
 
 
 SETTLED = 0.01          # a rotation is done when the gripper stays within 1 % of the move from its target
 
 
-
 STEADY_BELOW = paper_value("gripper-force-control", "F7.most")   # N, "in most of the cases it was below" (Fig. 7b)
 
 
-
 SAG_CASES = ("ideal", "friction", "no-feedforward")
-
 
 
 def grasp_forces(run: Run) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -40,13 +35,11 @@ def grasp_forces(run: Run) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return measured.index.to_numpy(), measured.to_numpy().squeeze(), commanded.to_numpy().squeeze()
 
 
-
 def motion_window(run: Run) -> tuple[float, float]:
     """First and last instant the set value generator moves the gripper (ω_sr ≠ 0)."""
     ref = run["/reference"]
     moving = ref.index[np.abs(ref["velocity.gripper"].to_numpy()) > 0]
     return float(moving[0]), float(moving[-1])
-
 
 
 def window_stats(run: Run, t0: float, t1: float, tracking: bool = True) -> dict[str, tuple[float, str]]:
@@ -64,12 +57,10 @@ def window_stats(run: Run, t0: float, t1: float, tracking: bool = True) -> dict[
     return stats
 
 
-
 def simulated_speed(run: Run) -> dict[str, tuple[float, str]]:
     t = run["/wrench"].index
     return {"simulation.wall_per_simulated_s": (float(run.metadata["wall_time_s"]) / float(t[-1] - t[0]),
                                                 "ratio")}
-
 
 
 def _config(run: Run, *keys: str):
@@ -77,7 +68,6 @@ def _config(run: Run, *keys: str):
     for key in keys:
         node = node[key]
     return node
-
 
 
 def cycle_times(run: Run) -> dict[str, tuple[float, str]]:
@@ -112,7 +102,6 @@ def cycle_times(run: Run) -> dict[str, tuple[float, str]]:
         "impact_force.max": (float(measured[t < start].max()), "N"),
         "grasp_error.before_rotation": (float(np.mean(measured[hold]) - f_set) if hold.any() else np.nan, "N"),
     }
-
 
 
 def slug(name: str) -> str:

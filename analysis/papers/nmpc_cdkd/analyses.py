@@ -69,7 +69,6 @@ def analyze_compute_time(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-
 def analyze_tracking(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     tool_error = {}
@@ -93,7 +92,6 @@ def analyze_tracking(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-
 def analyze_fixed_obstacles(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     by_case = {}
@@ -114,7 +112,6 @@ def analyze_fixed_obstacles(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-
 def analyze_moving_obstacles(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     for run in runs:
@@ -124,7 +121,6 @@ def analyze_moving_obstacles(runs: list[Run], figures: Figures) -> pd.DataFrame:
         _snapshots_figure(run, figures)
     _components_figure(ordered, figures, "fig7-components", "Fig. 7: tool position vs time with moving obstacles")
     return m.frame()
-
 
 
 ANALYSES = {"compute-time": analyze_compute_time, "tracking": analyze_tracking,

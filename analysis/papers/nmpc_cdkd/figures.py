@@ -27,7 +27,6 @@ def _table3_figure(mean: dict, std: dict, figures: Figures) -> None:
     figures.save(fig, "table3-solve-times")
 
 
-
 def _components_figure(runs: list[Run], figures: Figures, name: str, title: str) -> None:
     """Figs. 5 and 7: tool position components vs time, reference dashed."""
     fig, axes = plt.subplots(1, len(runs), figsize=(4.2 * len(runs), 3.2), sharey=True, squeeze=False)
@@ -43,7 +42,6 @@ def _components_figure(runs: list[Run], figures: Figures, name: str, title: str)
     axes[0, 0].legend(ncol=2, fontsize=7)
     fig.suptitle(title)
     figures.save(fig, name)
-
 
 
 def _fig3(run: Run, figures: Figures) -> None:
@@ -66,7 +64,6 @@ def _fig3(run: Run, figures: Figures) -> None:
     fig.suptitle(f"Fig. 3 ({run.run_id}, d_e = {run.config['system']['dh']['tool_d'] * 1e3:g} mm): no obstacles, "
                  "t0 = 0.5 s, t1 = 2 s")
     figures.save(fig, f"fig3-{run.run_id}")
-
 
 
 def _paths_figure(runs: list[Run], figures: Figures, name: str, title: str) -> None:
@@ -92,7 +89,6 @@ def _paths_figure(runs: list[Run], figures: Figures, name: str, title: str) -> N
     ax.legend(fontsize=7)
     ax.set_title(title, fontsize=9)
     figures.save(fig, name)
-
 
 
 def _snapshots_figure(run: Run, figures: Figures, count: int = 7) -> None:

@@ -16,30 +16,23 @@ from pipeline.core.runlog import Run
 XYZ = ("x", "y", "z")
 
 
-
 ARRIVAL_POSITION = 1e-3            # m
-
 
 
 ARRIVAL_ANGLE = np.deg2rad(0.5)    # rad
 
 
-
 FINAL_WINDOW = 0.5                 # s: "final error" = mean over the last 0.5 s
-
 
 
 CONTROL_HORIZON = 0.04             # s: 4 × 10 ms; solves longer than this delay the robot (Sec. 4.2)
 
 
-
 TARGETS = Path(__file__).with_name("targets.csv")
-
 
 
 CASE_LABELS = {"no-obstacle": "without obstacles", "obstacle": "with obstacle",
                "obstacle-height": "with obstacle and height constraints"}
-
 
 
 @cache
@@ -52,10 +45,8 @@ def paper_table3() -> dict[tuple[str, str, int], tuple[float, float]]:
             for n, k in ((1, 10), (2, 20))}
 
 
-
 def _xyz(frame: pd.DataFrame, field: str) -> np.ndarray:
     return frame[[f"{field}.{a}" for a in XYZ]].to_numpy()
-
 
 
 def _solve_metrics(solves: pd.DataFrame) -> dict[str, tuple[float, str]]:
@@ -69,12 +60,10 @@ def _solve_metrics(solves: pd.DataFrame) -> dict[str, tuple[float, str]]:
     return values
 
 
-
 def _combo(run_id: str) -> tuple[str, str, int]:
     model, rest = run_id.split("__")[0].split("-", 1)
     case, k = rest.rsplit("-k", 1)
     return model, case, int(k)
-
 
 
 def _arrival(run: Run) -> float:
@@ -89,7 +78,6 @@ def _arrival(run: Run) -> float:
         return float("nan")
     outside = np.flatnonzero(~inside)
     return float(tool.index[outside[-1] + 1] if len(outside) else tool.index[0])
-
 
 
 def _trajectory_metrics(run: Run) -> dict[str, tuple[float, str]]:
@@ -110,7 +98,6 @@ def _trajectory_metrics(run: Run) -> dict[str, tuple[float, str]]:
     values |= timing_metrics("planning", run["/compute_time"]["seconds.planning"].dropna())
     values |= _solve_metrics(run["/nmpc/solve"])
     return values
-
 
 
 def _obstacle_metrics(run: Run) -> dict[str, tuple[float, str]]:
@@ -136,11 +123,9 @@ def _obstacle_metrics(run: Run) -> dict[str, tuple[float, str]]:
     return values
 
 
-
 def _obstacle_layout(run: Run) -> tuple[list[str], np.ndarray, pd.DataFrame]:
     scene = run.config["system"]["scene"]
     return list(scene["obstacles"]["names"]), np.asarray(scene["obstacles"]["radii"]), run["/obstacles"]
-
 
 
 TRAJECTORY_COLUMNS = [  # (metric, column, factor from SI)

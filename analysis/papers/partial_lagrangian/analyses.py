@@ -58,7 +58,6 @@ def analyze_pendulum(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-
 def analyze_slider(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     for run in runs:
@@ -69,7 +68,6 @@ def analyze_slider(runs: list[Run], figures: Figures) -> pd.DataFrame:
         _chain_figure(run, "Link 2 changed to a slider, l2: 1 → 0.1 m under PID (Fig. 4)", figures,
                       views=(("(a) side view (y against t)", 0.0, 0.0), ("(b) front view (along t)", 0.0, -90.0)))
     return m.frame()
-
 
 
 def analyze_compute_time(runs: list[Run], figures: Figures) -> pd.DataFrame:
@@ -106,7 +104,6 @@ def analyze_compute_time(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-
 def analyze_checks(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     worst: dict[str, float] = {}
@@ -129,7 +126,6 @@ def analyze_checks(runs: list[Run], figures: Figures) -> pd.DataFrame:
     for key, value in worst.items():
         m.add("all", key, value, "fraction" if "trajectory" not in key else "rad")
     return m.frame()
-
 
 
 ANALYSES = {"one-link": analyze_pendulum, "two-link": analyze_pendulum, "three-link": analyze_pendulum,

@@ -64,7 +64,6 @@ def _chain_figure(run: Run, title: str, figures: Figures, twin: Run | None = Non
     figures.save(fig, run.run_id)
 
 
-
 def _compute_time_figure(curves: dict, figures: Figures, name: str) -> None:
     fig, axes = plt.subplots(1, len(KINDS), figsize=(16, 3.8))
     n = np.arange(1, 11)

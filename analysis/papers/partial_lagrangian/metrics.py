@@ -13,31 +13,24 @@ from pipeline.papers.partial_lagrangian.chain import from_config, gravity_torque
 STEADY_WINDOW = 1.0      # s: steady state = mean over the last second
 
 
-
 SETTLED_SPEED = 1e-2     # rad/s or m/s: settled if every controlled |q̇| stays below this over the last second
-
 
 
 SETTLING_BAND = 0.02     # settling time: last entry into ±2 % of the step
 
 
-
 SLOPE_FROM = 3           # log-log slopes fitted over n = 3..10
 
 
-
 SNAPSHOT_DT = 0.1        # s between chain drawings in the figures
-
 
 
 METHODS = {"full": "AD, full Lagrangian", "partial": "AD, partial Lagrangians summed (1 thread)",
            "column": "AD, column n alone (ideal n threads)", "mujoco": "MuJoCo mj_step (our extension)"}
 
 
-
 KINDS = {"eval": "dynamics evaluation q̈", "terms": "equation-of-motion terms (M, b)",
          "build": "graph generation + AD of the terms", "ops": "operations in the terms graph"}
-
 
 
 def _positions(run: Run) -> tuple[np.ndarray, np.ndarray, list[str]]:
@@ -46,10 +39,8 @@ def _positions(run: Run) -> tuple[np.ndarray, np.ndarray, list[str]]:
     return js.index.to_numpy(), js[[f"position.{n}" for n in names]].to_numpy(), names
 
 
-
 def _velocities(run: Run, names: list[str]) -> np.ndarray:
     return run["/joint_state"][[f"velocity.{n}" for n in names]].to_numpy()
-
 
 
 def _tips(run: Run) -> tuple[np.ndarray, np.ndarray]:
@@ -61,10 +52,8 @@ def _tips(run: Run) -> tuple[np.ndarray, np.ndarray]:
     return tf.index.to_numpy(), xy
 
 
-
 def _is_angle(name: str) -> bool:
     return name.startswith("theta")
-
 
 
 def _damped_oscillation(t: np.ndarray, q1: np.ndarray, energy: np.ndarray) -> dict[str, tuple[float, str]]:
@@ -74,7 +63,6 @@ def _damped_oscillation(t: np.ndarray, q1: np.ndarray, energy: np.ndarray) -> di
     reversals = int((np.sign(qd[1:]) * np.sign(qd[:-1]) < 0).sum())
     return {"reversals": (reversals, "count"), "energy.change": (energy[-1] - energy[0], "J"),
             "damped_oscillation": (float(reversals >= 3 and energy[-1] < energy[0]), "bool")}
-
 
 
 def _decay_rate(t: np.ndarray, q1: np.ndarray) -> float:
@@ -89,7 +77,6 @@ def _decay_rate(t: np.ndarray, q1: np.ndarray) -> float:
     return float(-np.polyfit(mid[later], np.log(half_swing[later]), 1)[0])
 
 
-
 def _linear_decay_rate(config: dict) -> float:
     """Small swings of one link about the hanging rest decay at c/(2 m l²), with the generalized damping
     c = d l² of the Cartesian damper or c = d of the joint damper."""
@@ -97,7 +84,6 @@ def _linear_decay_rate(config: dict) -> float:
     d, m, length = (system["links"][key][0] for key in ("damping", "mass", "length"))
     c = d * length ** 2 if system["damping_model"] == "cartesian" else d
     return c / (2 * m * length ** 2)
-
 
 
 def _energy_balance(run: Run, scale: float) -> float:
@@ -109,7 +95,6 @@ def _energy_balance(run: Run, scale: float) -> float:
     return float(np.abs(e["value.total"].to_numpy() - e["value.total"].iloc[0] - integral).max() / scale)
 
 
-
 def energy_scale(config: dict, n: int) -> float:
     """Σ m_i g r_i, r_i = distance of mass i from the base when straight: the energy drop from horizontal
     to hanging, the scale of every energy error."""
@@ -118,13 +103,11 @@ def energy_scale(config: dict, n: int) -> float:
     return float(np.sum(np.asarray(links["mass"][:n]) * config["system"]["gravity"] * reach))
 
 
-
 def static_equilibrium(config: dict, n: int, reference: np.ndarray, kp: np.ndarray) -> np.ndarray:
     """The rest posture of the PD law without gravity compensation: Kp (r − q) = ∂P/∂q, with
     the gravity torque from statics (not from either dynamics model); solved from q = r."""
     chain = from_config(config["system"], n)
     return fsolve(lambda q: kp * (reference - q) - gravity_torque(chain, q), reference, xtol=1e-12)
-
 
 
 def _control_metrics(run: Run, names: list[str]) -> dict[str, tuple[float, str]]:
@@ -157,7 +140,6 @@ def _control_metrics(run: Run, names: list[str]) -> dict[str, tuple[float, str]]
     return values
 
 
-
 def paper_term_counts(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Eq. (28): ½(n² + n)(n² + 2n) terms without dividing; eq. (29): n(n² + 2n) with partial Lagrangians
     on n threads. The paper's own model of Fig. 5b."""
@@ -165,12 +147,10 @@ def paper_term_counts(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 * (n * n + n) * (n * n + 2 * n), n * (n * n + 2 * n)
 
 
-
 def slope(n: np.ndarray, seconds: np.ndarray) -> float:
     """Exponent p of time ∝ n^p, least squares in log-log over n ≥ SLOPE_FROM."""
     keep = n >= SLOPE_FROM
     return float(np.polyfit(np.log(n[keep]), np.log(seconds[keep]), 1)[0])
-
 
 
 def _timing_table(ct: pd.DataFrame) -> pd.DataFrame:

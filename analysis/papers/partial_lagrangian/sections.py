@@ -36,7 +36,6 @@ def _pd_section(metrics: dict[str, pd.DataFrame]) -> Section | None:
         Table(pd.DataFrame(rows), ".3f"), category="tracking errors")
 
 
-
 def _per_n_table(ct: pd.DataFrame, run_id: str, ns: list[int], columns: list[tuple[str, str]]) -> Table:
     """Median (p95) in µs of each (kind, method) by n."""
     rows = []
@@ -47,7 +46,6 @@ def _per_n_table(ct: pd.DataFrame, run_id: str, ns: list[int], columns: list[tup
             row[f"{kind} {method}"] = f"{med:.3g} ({p95:.3g})"
         rows.append(row)
     return Table(pd.DataFrame(rows))
-
 
 
 def _compute_time_sections(ct: pd.DataFrame, runs: pd.DataFrame) -> list[Section]:
@@ -86,7 +84,6 @@ def _compute_time_sections(ct: pd.DataFrame, runs: pd.DataFrame) -> list[Section
     return [main, text]
 
 
-
 def _checks_section(checks: pd.DataFrame) -> Section:
     columns = {"mass_matrix.max_rel": "M vs MuJoCo", "bias.max_rel": "b vs MuJoCo", "qdd_mujoco.max_rel": "q̈ vs MuJoCo",
                "qdd_full_partial.max_rel": "q̈ full vs partial", "closed_form.max_rel": "closed form (n = 2)",
@@ -104,7 +101,6 @@ def _checks_section(checks: pd.DataFrame) -> Section:
             "energy change of the undamped chain over the run, relative to Σ m g r (the energy from horizontal to "
             "hanging).",
         Table(table.loc[order], ".2g", index=True))
-
 
 
 def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]:

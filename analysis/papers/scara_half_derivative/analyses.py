@@ -55,7 +55,6 @@ def analyze_setpoint(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-
 def analyze_table2(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     by_stiffness: dict[float, dict[str, tuple[Run, dict]]] = {}
@@ -84,7 +83,6 @@ def analyze_table2(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-
 def analyze_maps(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     grid = grid_frame(runs)
@@ -106,7 +104,6 @@ def analyze_maps(runs: list[Run], figures: Figures) -> pd.DataFrame:
         m.add(sid, "claim.ise_decreases", float(_monotonic(part, "ise", -1)), "bool", {"k_xyz": k})
         _map_figure(k, part, level, points, figures)
     return m.frame()
-
 
 
 def analyze_locus(runs: list[Run], figures: Figures) -> pd.DataFrame:
@@ -133,7 +130,6 @@ def analyze_locus(runs: list[Run], figures: Figures) -> pd.DataFrame:
             m.add(sid, "middle.max_torque_change", float(change), "fraction")
         _path_figure(k, path, ratio, figures)
     return m.frame()
-
 
 
 ANALYSES = {"setpoint": analyze_setpoint, "table2": analyze_table2, "maps": analyze_maps, "locus": analyze_locus}

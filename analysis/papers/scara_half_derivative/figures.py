@@ -42,7 +42,6 @@ def _setpoint_figures(ref: pd.DataFrame, joints: pd.DataFrame, figures: Figures)
     figures.save(fig, "fig5-joints")
 
 
-
 def _error_figures(k: float, controllers: dict[str, tuple[Run, dict]], figures: Figures) -> None:
     """Figs. 8-10: e_x, e_y, e_z of the three controllers, the whole run and a zoom on the largest peak."""
     for fig_number, axis in zip((8, 9, 10), AXES, strict=True):
@@ -69,7 +68,6 @@ def _error_figures(k: float, controllers: dict[str, tuple[Run, dict]], figures: 
         full.legend(ncol=3, loc="center", bbox_to_anchor=(0.5, 0.75))   # between the traces and the paper lines
         fig.suptitle(f"Fig. {fig_number}: error e_{axis}, K = {k:g} N/m")
         figures.save(fig, f"fig{fig_number}-e{axis}-{_stiffness_id(k)}")
-
 
 
 def _map_figure(k: float, grid: pd.DataFrame, level: float, points: list, figures: Figures) -> None:
@@ -122,7 +120,6 @@ def _map_figure(k: float, grid: pd.DataFrame, level: float, points: list, figure
     fig.suptitle(f"Fig. 6: ICE (left) and ISE (right) over the grid on disk, K = {k:g} N/m "
                  "(green: KD at d = 5000; white: its level)")
     figures.save(fig, f"fig6-maps-{_stiffness_id(k)}")
-
 
 
 def _path_figure(k: float, path: pd.DataFrame, ratio: pd.DataFrame, figures: Figures) -> None:

@@ -14,47 +14,36 @@ from pipeline.core.runlog import Run
 AXES = ("x", "y", "z")
 
 
-
 JOINT_TORQUES = [f"value.theta{i}" for i in range(1, 5)]
-
 
 
 NOISE = 1e-9                 # SI: a reference value this small is round-off (τ4 ≡ 0 in the model)
 
 
-
 KD_DAMPING = 5000.0          # N s/m: the reference KD of every comparison (Sec. 5)
 
 
-
 LEVEL_TOLERANCE = 1e-9       # relative: grid values this close count as equal
-
 
 
 TABLE2 = ["e.x.max", "e.y.max", "e.z.max", "e.x.mean", "e.y.mean", "e.z.mean", "tau1.max", "tau2.max",
           "tau3.max", "tau4.max", "ise"]
 
 
-
 CONTROLLER_COLORS = {"kd": "C0", "kdhd": "C3", "khd": "C2"}
-
 
 
 FULL_PLOT_STRIDE = 5       # samples drawn in the whole-run panels (the zoom draws every sample)
 
 
-
 ZOOM = (0.08, 0.25)        # s before and after the peak in the zoom panels
-
 
 
 SWING = 5e-6                 # m: an error reversal this large counts as one swing of an oscillation
 
 
-
 def _model(run: Run) -> dict:
     return yaml.safe_load(run.attachments["model.yaml"])
-
 
 
 def _tuning(run: Run) -> dict[str, float]:
@@ -62,10 +51,8 @@ def _tuning(run: Run) -> dict[str, float]:
     return {"k_xyz": g["k_xyz"], "d_xyz": g["d_xyz"], "hd_xyz": g["hd_xyz"]}
 
 
-
 def _stiffness_id(k: float) -> str:
     return f"k{k:g}"
-
 
 
 def tuning_metrics(run: Run) -> dict[str, tuple[float, str]]:
@@ -90,7 +77,6 @@ def tuning_metrics(run: Run) -> dict[str, tuple[float, str]]:
     return values
 
 
-
 def _percentages(m: MetricTable, reference: dict, variant: dict, run_id: str, params: dict, names) -> None:
     for name in names:
         base = reference[name][0]
@@ -98,12 +84,10 @@ def _percentages(m: MetricTable, reference: dict, variant: dict, run_id: str, pa
             m.add(run_id, f"pct.{name}", variant[name][0] / base - 1.0, "fraction", params)
 
 
-
 def _config_node(run: Run):
     from omegaconf import OmegaConf
 
     return OmegaConf.create(run.config["system"])
-
 
 
 def _reversals(e: np.ndarray, amplitude: float) -> int:
@@ -122,12 +106,10 @@ def _reversals(e: np.ndarray, amplitude: float) -> int:
     return count
 
 
-
 def _ringing(run: Run) -> int:
     """Swings of e_x, e_y, e_z larger than SWING over the run: the oscillation that Figs. 8-10 show."""
     err = run["/tracking_error"]
     return sum(_reversals(err[f"error.{axis}"].to_numpy(), SWING) for axis in AXES)
-
 
 
 def grid_frame(runs: list[Run]) -> pd.DataFrame:
@@ -139,7 +121,6 @@ def grid_frame(runs: list[Run]) -> pd.DataFrame:
         return pd.DataFrame(columns=["k_xyz", "d_xyz", "hd_xyz", "run_id", "ise", "ice"])
     frame = pd.DataFrame(rows).sort_values(["k_xyz", "d_xyz", "hd_xyz", "run_id"])
     return frame.drop_duplicates(["k_xyz", "d_xyz", "hd_xyz"]).reset_index(drop=True)
-
 
 
 def equal_ice_locus(grid: pd.DataFrame) -> tuple[float, list[tuple[float, float]]]:
@@ -163,14 +144,12 @@ def equal_ice_locus(grid: pd.DataFrame) -> tuple[float, list[tuple[float, float]
     return level, sorted(set(points))
 
 
-
 def _monotonic(grid: pd.DataFrame, metric: str, sign: int) -> bool:
     """`metric` changes with the sign `sign` along every grid line of d and of hd."""
     table = grid.pivot(index="d_xyz", columns="hd_xyz", values=metric)
     steps = [np.diff(table.to_numpy(), axis=0), np.diff(table.to_numpy(), axis=1)]
     finite = [s[np.isfinite(s)] for s in steps]
     return bool(all((sign * s > 0).all() for s in finite) and any(s.size for s in finite))
-
 
 
 SLUG = "scara-half-derivative"
@@ -185,7 +164,6 @@ def paper_table2() -> dict[str, tuple[float, float, float]]:
         return f"T2.{name}.{controller}.k8e5"
 
     return {m: tuple(paper_value(SLUG, target(m, c)) for c in ("kd", "kdhd", "khd")) for m in TABLE2_ROWS}
-
 
 
 SCALE = {"e": 1e3}   # m -> mm for the error rows

@@ -47,13 +47,11 @@ def analyze_paths(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-
 def analyze_printed(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m, by_case, _ = _per_run(runs)
     _errors(by_case, "Tracking error with eqs. (25), (58), (60) as printed", figures, "printed-tracking-error")
     _paths_3d(by_case, "diamond", "Diamond path with eqs. (25), (58) as printed", figures, "printed-diamond-3d")
     return m.frame()
-
 
 
 def analyze_sweep(runs: list[Run], figures: Figures) -> pd.DataFrame:
@@ -68,7 +66,6 @@ def analyze_sweep(runs: list[Run], figures: Figures) -> pd.DataFrame:
         pivot = tc.pivot_table(index="case", columns="setting", values="value", aggfunc="first", dropna=False)
         _sweep_figure(pivot, params, figures)
     return frame
-
 
 
 def analyze_physics(runs: list[Run], figures: Figures) -> pd.DataFrame:
@@ -108,7 +105,6 @@ def analyze_physics(runs: list[Run], figures: Figures) -> pd.DataFrame:
         traces.append((robot, t, moving, ratio, phys["value.slip_speed"], e, e_kin))
     _physics_figure(traces, figures)
     return m.frame()
-
 
 
 ANALYSES = {"paths": analyze_paths, "printed": analyze_printed, "sweep": analyze_sweep,

@@ -18,7 +18,6 @@ def _surface(ax, terrain: CosineTerrain, extent: float = 2.6) -> None:
     ax.plot_wireframe(x, y, terrain.height(x, y), rstride=2, cstride=2, color="0.75", lw=0.4)
 
 
-
 def _paths_3d(runs: dict[str, Run], path: str, title: str, figures: Figures, name: str) -> None:
     fig = plt.figure(figsize=(7, 5.5))
     ax = fig.add_subplot(projection="3d")
@@ -44,7 +43,6 @@ def _paths_3d(runs: dict[str, Run], path: str, title: str, figures: Figures, nam
     figures.save(fig, name)
 
 
-
 def _xyz_vs_time(runs: dict[str, Run], path: str, title: str, figures: Figures, name: str) -> None:
     fig, axes = plt.subplots(3, 1, figsize=(8, 6.5), sharex=True)
     for k, axis in enumerate("xyz"):
@@ -64,7 +62,6 @@ def _xyz_vs_time(runs: dict[str, Run], path: str, title: str, figures: Figures, 
     axes[-1].set_xlabel("time [s]")
     fig.suptitle(title)
     figures.save(fig, name)
-
 
 
 def _controls(runs: dict[str, Run], robot: str, title: str, figures: Figures, name: str) -> None:
@@ -95,7 +92,6 @@ def _controls(runs: dict[str, Run], robot: str, title: str, figures: Figures, na
     figures.save(fig, name)
 
 
-
 def _tilt(runs: dict[str, Run], figures: Figures, name: str) -> None:
     fig, ax = plt.subplots(figsize=(8, 2.8))
     limit = None
@@ -114,7 +110,6 @@ def _tilt(runs: dict[str, Run], figures: Figures, name: str) -> None:
     ax.set_title("Fig. 12(b) regenerated: tilting angle, limit ±π/3 dotted")
     ax.legend()
     figures.save(fig, name)
-
 
 
 def _errors(runs: dict[str, Run], title: str, figures: Figures, name: str) -> None:

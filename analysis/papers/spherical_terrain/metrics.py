@@ -16,25 +16,19 @@ SLUG = "spherical-terrain"
 LABEL = {"3r": "3R-SR", "2r": "2R-SR", "rt": "RT-SR", "rs": "RS-SR"}
 
 
-
 COLOR = {"3r": "C0", "2r": "C1", "rt": "C2", "rs": "C3"}
-
 
 
 EPSILONS = (0.05, 0.1, 0.2)      # m, convergence thresholds
 
 
-
 WINDOWS = (40.0, 30.0)           # s, start of the steady-state window
-
 
 
 VERTEX_HALF_WIDTH = 5.0          # s, error near a vertex: within ±5 s of the target passing it
 
 
-
 CLAIM_TIME = 45.0                # s, "converges in approximately 30 s": t_c(0.1 m) ≤ 1.5 × 30 s
-
 
 
 def convergence_time(t: np.ndarray, e: np.ndarray, eps: float) -> float:
@@ -45,17 +39,14 @@ def convergence_time(t: np.ndarray, e: np.ndarray, eps: float) -> float:
     return float(t[above[-1] + 1]) if above[-1] + 1 < len(t) else float("nan")
 
 
-
 def _case(run: Run) -> tuple[str, str]:
     robot, path = run.metadata["case"].split("-", 1)
     return robot, path
 
 
-
 def _terrain(run: Run) -> CosineTerrain:
     t = run.config["system"]["terrain"]
     return CosineTerrain(t["amplitude"], t["frequency"])
-
 
 
 def tracking_metrics(run: Run) -> dict[str, tuple[float, str]]:
@@ -101,7 +92,6 @@ def tracking_metrics(run: Run) -> dict[str, tuple[float, str]]:
     return values
 
 
-
 def _reference_metrics(runs: dict[str, Run]) -> dict[str, tuple[float, str]]:
     """The reference paths as generated, measured from the logs (radius, rate, diagonals)."""
     values = {}
@@ -120,7 +110,6 @@ def _reference_metrics(runs: dict[str, Run]) -> dict[str, tuple[float, str]]:
     return values
 
 
-
 def _agility(table: pd.DataFrame) -> dict[str, tuple[float, str]]:
     """Sec. 6: '3R and 2R-SRs outperform RT and RS-SRs in tracking the nonsmooth trajectory', as ratios
     worst(3R, 2R) / best(RT, RS) on the diamond (< 1 when the claim holds)."""
@@ -130,7 +119,6 @@ def _agility(table: pd.DataFrame) -> dict[str, tuple[float, str]]:
         if all(v is not None for v in got.values()):
             values[name] = (max(got["3r"], got["2r"]) / min(got["rt"], got["rs"]), "ratio")
     return values
-
 
 
 def convergence_summary(table: dict) -> dict[str, tuple[float, str]]:
@@ -155,9 +143,7 @@ def _per_run(runs: list[Run]) -> tuple[MetricTable, dict[str, Run], dict]:
     return m, by_case, table
 
 
-
 MOVING = 0.02   # m/s: samples where the paper's model moves the contact point slower than this are left out
-
 
 
 RUN_COLUMNS = {"tc_0.1": "t_c(0.1 m) [s]", "tc_0.05": "t_c(0.05 m) [s]", "first_entry_0.1": "first ≤ 0.1 m [s]",

@@ -20,7 +20,6 @@ def _run_table(frame: pd.DataFrame) -> pd.DataFrame:
     return table.reset_index()
 
 
-
 def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]:
     sections = []
     for name, title, text in (

@@ -35,7 +35,6 @@ def analyze_joint_model(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-
 def analyze_reach_poses(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     by_case = {r.metadata["case"]: r for r in runs}
@@ -69,7 +68,6 @@ def analyze_reach_poses(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-
 def analyze_avoid_obstacles(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     for run in runs:
@@ -93,7 +91,6 @@ def analyze_avoid_obstacles(runs: list[Run], figures: Figures) -> pd.DataFrame:
     if "avoid" in by_id:
         _obstacle_figures(by_id, figures)
     return m.frame()
-
 
 
 ANALYSES = {"joint-model": analyze_joint_model, "reach-poses": analyze_reach_poses,

@@ -59,7 +59,6 @@ def _joint_figures(plant: str, runs: dict[str, Run], figures: Figures, velocitie
     figures.save(fig, f"fig10-spatial-velocity-{plant}")
 
 
-
 def _pose_figure(target: str, runs: dict[str, Run], figures: Figures) -> None:
     """Figs. 13/14: end-effector position and orientation errors vs time."""
     fig, axes = plt.subplots(2, 2, figsize=(10, 5.5), sharex=True)
@@ -81,7 +80,6 @@ def _pose_figure(target: str, runs: dict[str, Run], figures: Figures) -> None:
     figures.save(fig, f"fig{13 if target == 'A' else 14}-target-{target}")
 
 
-
 def _random_figure(runs: list[Run], figures: Figures) -> None:
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.2), sharex=True)
     for run in runs:
@@ -96,7 +94,6 @@ def _random_figure(runs: list[Run], figures: Figures) -> None:
     axes[0].legend(fontsize=7)
     fig.suptitle("targets made by FK of random configurations: convergence of the whole loop (IK, planning, trolleys)")
     figures.save(fig, "reachable-targets")
-
 
 
 def _obstacle_figures(runs: dict[str, Run], figures: Figures) -> None:

@@ -14,9 +14,7 @@ from pipeline.core.runlog import Run
 REACHED_POSITION = 1e-4
 
 
-
 REACHED_ANGLE = np.radians(0.05)
-
 
 
 # "value consistency" (Fig. 8) and "coincidence" (Fig. 10), made a rule: the largest model-minus-measured
@@ -24,14 +22,11 @@ REACHED_ANGLE = np.radians(0.05)
 CONSISTENT = 0.01
 
 
-
 SLUG = "src-joint"
 EULER = ["X", "Y", "Z"]
 
 
-
 SIX = ["wx", "wy", "wz", "vx", "vy", "vz"]
-
 
 
 # eqs. (66), (67): the paper's IK solutions q^r_i, scalar first
@@ -41,10 +36,8 @@ PRINTED_IK = {"A": [[0.7992, 0.1912, -0.5698, 0.0016], [-0.5579, -0.1939, -0.771
                     [0.0880, 0.2577, 0.8231, -0.4983]]}
 
 
-
 def _columns(frame: pd.DataFrame, prefix: str, names) -> np.ndarray:
     return frame[[f"{prefix}.{k}" for k in names]].to_numpy()
-
 
 
 def _joint_metrics(run: Run) -> dict[str, tuple[float, str]]:
@@ -95,13 +88,11 @@ def _joint_metrics(run: Run) -> dict[str, tuple[float, str]]:
     return values
 
 
-
 def _final_errors(run: Run) -> tuple[np.ndarray, np.ndarray, float, float]:
     """(e_p (3,) m, e_o XYZ (3,) rad, |e_p|, rotation angle) at the end of a run."""
     p, o = run["/tracking_error"], run["/tracking_error/orientation"]
     return (_columns(p, "error", "xyz")[-1], _columns(o, "error", EULER)[-1], float(p["norm"].iloc[-1]),
             float(o["norm"].iloc[-1]))
-
 
 
 def _time_below(run: Run, threshold: float) -> float:
@@ -111,7 +102,6 @@ def _time_below(run: Run, threshold: float) -> float:
     if not len(above):
         return float(norm.index[0])
     return float(norm.index[above[-1] + 1]) if above[-1] + 1 < len(norm) else float("nan")
-
 
 
 def _reach_metrics(run: Run) -> dict[str, tuple[float, str]]:
@@ -138,7 +128,6 @@ def _reach_metrics(run: Run) -> dict[str, tuple[float, str]]:
     wheels = run["/command"].drop(columns="kind").to_numpy()
     values["wheel_speed_max"] = (np.abs(wheels).max(), "rad/s")
     return values
-
 
 
 def _bars(frame: pd.DataFrame) -> list[str]:

@@ -36,7 +36,6 @@ def _joint_section(frame: pd.DataFrame) -> Section:
         category="tracking errors")
 
 
-
 def _reach_section(frame: pd.DataFrame) -> Section:
     rows = []
     for run_id in sorted(set(frame["run_id"]) - {"random"}):
@@ -60,7 +59,6 @@ def _reach_section(frame: pd.DataFrame) -> Section:
         Table(pd.DataFrame(rows), ".3g"), category="tracking errors")
 
 
-
 def _obstacle_section(frame: pd.DataFrame) -> Section:
     rows = [{"case": run_id,
              **{f"min clearance {bar} [mm]": metric_value(frame, run_id, f"clearance.{bar}.min") * 1e3
@@ -77,7 +75,6 @@ def _obstacle_section(frame: pd.DataFrame) -> Section:
             "5 mm (assumed); dampers act below 40 mm with gain 0.5 s⁻¹ and keep 10 mm (the paper's safety distance). "
             "`unconstrained` is the same loop without the dampers.",
         Table(pd.DataFrame(rows), ".4g"), category="trajectories")
-
 
 
 def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]:

@@ -6,9 +6,9 @@ import numpy as np
 import pandas as pd
 
 from analysis.core.compute_time import timing_metrics
-from analysis.core.figures import Figures, plt
+from analysis.core.figures import Figures
 from analysis.core.metrics import MetricTable
-from analysis.papers.ur5_ik_fsm.figures import _path_figure, _table6_figure
+from analysis.papers.ur5_ik_fsm.figures import _path_figure, _per_call_figure, _table6_figure
 from analysis.papers.ur5_ik_fsm.metrics import AGREE_TOL, ALGORITHMS, JOINT_COLUMNS, _nonsingular, _path_metrics, wrap
 from pipeline.core.runlog import Run
 
@@ -42,7 +42,6 @@ def analyze_tables(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return frame
 
 
-
 def analyze_singular_paths(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     by_path: dict[str, dict[str, tuple[dict, np.ndarray, np.ndarray, Run]]] = {}
@@ -69,7 +68,6 @@ def analyze_singular_paths(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-
 def analyze_compute_time(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     for run in runs:
@@ -88,20 +86,8 @@ def analyze_compute_time(runs: list[Run], figures: Figures) -> pd.DataFrame:
                                           "ratio")
         values["ratio.median_time"] = (values["alg2.median"][0] / values["alg1.median"][0], "ratio")
         m.add_run(run, values)
-        fig, ax = plt.subplots(figsize=(6, 3.2))
-        names = list(stats)
-        med = [np.median(stats[n]) * 1e6 for n in names]
-        p95 = [np.percentile(stats[n], 95) * 1e6 for n in names]
-        ax.bar(names, med, color=["C0", "C0", "C1", "C1"], alpha=0.8, label="median")
-        ax.errorbar(names, med, yerr=[np.zeros(len(med)), np.subtract(p95, med)], fmt="none", ecolor="k",
-                    capsize=4, label="p95")
-        ax.set_yscale("log")
-        ax.set_ylabel("time per pose [µs]")
-        ax.set_title(f"{run.run_id}: scalar (per call) and batched (per pose)")
-        ax.legend()
-        figures.save(fig, f"{run.run_id}-per-call")
+        _per_call_figure(run.run_id, stats, figures)
     return m.frame()
-
 
 
 ANALYSES = {"tables": analyze_tables, "singular-paths": analyze_singular_paths,

@@ -38,7 +38,6 @@ def _table6_figure(metrics: pd.DataFrame, figures: Figures) -> None:
     figures.save(fig, "table6-displacement", tight=False)
 
 
-
 def _path_figure(key: str, algs: dict, figures: Figures) -> None:
     fig, axes = plt.subplots(4, 1, figsize=(8, 9), sharex=True)
     for ax, alg in zip(axes[:2], ALGORITHMS, strict=True):
@@ -66,3 +65,19 @@ def _path_figure(key: str, algs: dict, figures: Figures) -> None:
     axes[3].legend()
     fig.suptitle(f"{key}: IK selection and MuJoCo execution")
     figures.save(fig, key)
+
+
+def _per_call_figure(run_id: str, stats: dict[str, np.ndarray], figures: Figures) -> None:
+    """Median and p95 time per pose of each algorithm, scalar and batched (the paper reports no times)."""
+    fig, ax = plt.subplots(figsize=(6, 3.2))
+    names = list(stats)
+    med = [np.median(stats[n]) * 1e6 for n in names]
+    p95 = [np.percentile(stats[n], 95) * 1e6 for n in names]
+    ax.bar(names, med, color=["C0", "C0", "C1", "C1"], alpha=0.8, label="median")
+    ax.errorbar(names, med, yerr=[np.zeros(len(med)), np.subtract(p95, med)], fmt="none", ecolor="k",
+                capsize=4, label="p95")
+    ax.set_yscale("log")
+    ax.set_ylabel("time per pose [µs]")
+    ax.set_title(f"{run_id}: scalar (per call) and batched (per pose)")
+    ax.legend()
+    figures.save(fig, f"{run_id}-per-call")

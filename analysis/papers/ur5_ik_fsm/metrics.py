@@ -12,26 +12,20 @@ from pipeline.papers.ur5_ik_fsm.kinematics import Geometry, shoulder_term
 JOINT_COLUMNS = [f"position.joint{i}" for i in range(1, 7)]
 
 
-
 ALGORITHMS = ("alg1", "alg2")
-
 
 
 AGREE_TOL = 1e-6     # rad: two selections are the same set
 
 
-
 JUMP_THRESHOLD = 0.5  # rad: a step between samples larger than this is a jump (assumption)
-
 
 
 TARGETS = Path(__file__).with_name("targets.csv")
 
 
-
 def wrap(x: np.ndarray) -> np.ndarray:
     return np.remainder(np.asarray(x) + np.pi, 2 * np.pi) - np.pi
-
 
 
 def _nonsingular(q: np.ndarray, config: dict) -> np.ndarray:
@@ -39,7 +33,6 @@ def _nonsingular(q: np.ndarray, config: dict) -> np.ndarray:
     c, g = config["system"]["conventions"], Geometry(**config["system"]["geometry"])
     return ((np.abs(np.sin(q[:, 2])) > c["s3_min"]) & (np.abs(np.sin(q[:, 4])) > c["s5_min"])
             & (np.abs(shoulder_term(q, g)) > c["shoulder_min"]))
-
 
 
 def _path_metrics(run: Run) -> tuple[dict, np.ndarray, np.ndarray]:
