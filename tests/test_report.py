@@ -121,9 +121,12 @@ def test_not_run_and_failed_runs():
     assert evaluate("p", _targets(), {}, _runs()).iloc[0]["status"] == "not run"
     swept = evaluate("p", _targets(), _metrics(1.0, run="r1-k=2"), _runs(("r1-k=2", "ok"))).iloc[0]
     assert swept["status"] == "not run"
-    # the run was made and failed: a miss that says why
+    # the run was made and failed: a miss that says why; so is an aggregate a failed run left without a value
     failed = evaluate("p", _targets(), {}, _runs(("r1", "failed: diverged at t = 1 s"))).iloc[0]
     assert failed["status"] == "miss" and "diverged" in failed["note"]
+    runs = _runs(("r1", "ok"), ("r2", "failed: unstable"))
+    aggregate = evaluate("p", _targets(run="all"), _metrics(1.0), runs).iloc[0]
+    assert aggregate["status"] == "miss" and "r2 failed: unstable" in aggregate["note"]
 
 
 def test_consistency_rows_are_never_reproductions():

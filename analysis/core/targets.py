@@ -192,14 +192,19 @@ def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
             table = metrics.get(t.experiment)
             of_run = pd.DataFrame() if table is None else table[table["run_id"] == t.run]
             found = of_run[of_run["metric"] == t.metric] if not of_run.empty else of_run
-            # neither a recorded run nor an aggregate of that id: e.g. only a sweep of the experiment is on disk
-            if of_run.empty and (t.experiment, t.run) not in made:
+            failed_here = {r: s for (e, r), s in failed.items() if e == t.experiment}
+            # neither a recorded run nor an aggregate of that id, and nothing failed: e.g. only a sweep of the
+            # experiment is on disk
+            if of_run.empty and (t.experiment, t.run) not in made and not failed_here:
                 row["status"] = "not run"
             elif found.empty:
                 row["status"] = "miss"
                 why = failed.get((t.experiment, t.run))
-                why = f"run {t.experiment}/{t.run} {why}" if why else \
-                    f"no pipeline value ({t.experiment}/{t.run}: {t.metric})"
+                if why:
+                    why = f"run {t.experiment}/{t.run} {why}"
+                else:
+                    why = f"no pipeline value ({t.experiment}/{t.run}: {t.metric})" + "".join(
+                        f"; run {t.experiment}/{r} {s}" for r, s in failed_here.items())
                 row["note"] = "; ".join(x for x in (t.note, why) if x)
             else:
                 value = convert(float(found["value"].iloc[0]), found["unit"].iloc[0], t.unit)
