@@ -6,10 +6,12 @@ A paper's analysis package `analysis.papers.<module>` holds `paper.yaml` (title,
     ANALYSES: dict[str, Callable[[list[Run], Figures], pd.DataFrame]]   # experiment name -> tidy metrics
     report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]   # optional extras
 
-Its `__init__.py` only imports and names these; the work lives in modules named for what they do
-(`metrics.py`, `figures.py`, `tables.py`, `sections.py`, ...). `Section`/`Table` (analysis/core/sections.py) are
-the report sections' prose and tables; the figures each analysis saves are declared in paper.yaml with their
-caption, the paper figure they regenerate and their place on the page (analysis/core/report.py says how).
+Its `__init__.py` only imports and names these; the work lives in modules named for what they do:
+`metrics.py` (constants, what is read from a run, metric computations), `figures.py` (plots; a value the paper
+prints is drawn from targets.csv with analysis.core.targets.paper_value, labelled "paper"), `analyses.py` (one
+analysis per experiment, and ANALYSES) and `sections.py` (report_sections: `Section`s of prose and `Table`s,
+analysis/core/sections.py). The figures each analysis saves are declared in paper.yaml with their caption, the
+paper figure they regenerate and their place on the page (analysis/core/report.py says how).
 """
 
 from __future__ import annotations
