@@ -187,7 +187,7 @@ def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
                "basis": t.basis, "tolerance": str(tol), "status": "not-reproducible", "cause": "", "note": t.note,
                "experiment": t.experiment, "run": t.run}
         if t.mode == "not reproducible":
-            row["cause"] = t.cause or "hardware-only"
+            row["cause"] = t.cause   # as declared: the hardware, a missing parameter, ...
         else:
             table = metrics.get(t.experiment)
             of_run = pd.DataFrame() if table is None else table[table["run_id"] == t.run]
