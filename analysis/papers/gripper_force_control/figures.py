@@ -13,7 +13,7 @@ from pipeline.core.runlog import Run
 
 def _sag_figure(runs: list[Run], figures: Figures) -> None:
     by_case = {run.metadata["case"]: run for run in runs}
-    fig, (ax, ax_phi) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, height_ratios=[2, 1])
+    fig, (ax, ax_phi) = plt.subplots(2, 1, figsize=(10, 6), sharex=True, height_ratios=[2, 1])
     for i, case in enumerate(SAG_CASES):
         for plant, style in (("mujoco", "-"), ("lumped", "--")):
             run = by_case.get(f"{case}-{plant}")
@@ -31,7 +31,7 @@ def _sag_figure(runs: list[Run], figures: Figures) -> None:
                    label=f"paper: {SAG_CASES[i]} sag {100 * sag:g} %")
     ax.set_ylabel("grasping force F_f [N]")
     ax.set_title("Fig. 8: grasping force during a 40° rotation (MuJoCo: contact force; lumped: pad force)")
-    ax.legend(ncol=2, fontsize=7)
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))   # beside the traces, not on them
     ref = any_run["/reference"]
     joints = any_run["/joint_state"]
     ax_phi.plot(ref.index * 1e3, np.rad2deg(ref["position.gripper"]), "k:", label="φ_sr")
