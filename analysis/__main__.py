@@ -1,9 +1,11 @@
-"""Analyze and report stages CLI.
+"""Analyze and report stages CLI (a Hydra app: `--help` lists every experiment, `--cfg job` prints the config).
 
     python -m analysis                                   every experiment with runs on disk, then the report
     python -m analysis experiment=<slug>/<name>          one experiment's metrics and figures, then the report
     python -m analysis stage=report                      only the report, from the metrics on disk
     python -m analysis data_dir=/elsewhere ...           where runs are read and outputs written (default data)
+
+Bad input is refused in one line before Hydra starts (exit 2, nothing written).
 """
 
 from __future__ import annotations
@@ -14,13 +16,15 @@ from pathlib import Path
 
 KEYS = {"experiment": None, "data_dir": "data", "stage": "all"}
 STAGES = ("all", "analyze", "report")
+CONF_DIR = Path(__file__).resolve().parent / "conf"
 
 
-def parse(argv: list[str]) -> dict[str, str | None]:
+def parse(overrides: list[str]) -> dict[str, str | None]:
+    """Check the overrides: known keys, a known experiment, a known stage."""
     from pipeline.core.experiment import available_experiments
 
     args = dict(KEYS)
-    for arg in argv:
+    for arg in overrides:
         key, eq, value = arg.partition("=")
         if not eq:
             raise ValueError(f"expected key=value, got '{arg}' (keys: {', '.join(KEYS)})")
@@ -28,7 +32,7 @@ def parse(argv: list[str]) -> dict[str, str | None]:
             hint = difflib.get_close_matches(key, KEYS, n=1)
             raise ValueError(f"unknown key '{key}'" + (f" (did you mean '{hint[0]}'?)" if hint else
                                                        f"; keys: {', '.join(KEYS)}"))
-        args[key] = value
+        args[key] = None if value == "null" else value
     if args["stage"] not in STAGES:
         raise ValueError(f"stage={args['stage']} must be one of {', '.join(STAGES)}")
     known = available_experiments()
@@ -50,17 +54,35 @@ def parse(argv: list[str]) -> dict[str, str | None]:
 
 
 def main() -> None:
-    try:
-        args = parse(sys.argv[1:])
-    except ValueError as err:
-        print(f"error: {err}", file=sys.stderr)
-        sys.exit(2)
-    from analysis.core.stages import run
+    from pipeline.core.cli import register_help_resolver, runs_nothing, split_args
+
+    flags, overrides = split_args(sys.argv[1:])
+    sys.argv[1:] = flags + overrides
+    if not runs_nothing(flags):
+        try:
+            parse(overrides)
+        except ValueError as err:
+            print(f"error: {err}", file=sys.stderr)
+            sys.exit(2)
+
+    import hydra
+    from omegaconf import DictConfig
+
     from pipeline.core import interrupts
+
+    register_help_resolver()
+
+    @hydra.main(config_path=str(CONF_DIR), config_name="analysis", version_base=None)
+    def task(cfg: DictConfig) -> None:
+        from analysis.core.stages import run
+
+        code = run(Path(cfg.data_dir), cfg.experiment, cfg.stage)
+        if code:
+            raise SystemExit(code)
 
     interrupts.install()
     try:
-        sys.exit(run(Path(args["data_dir"]), args["experiment"], args["stage"]))
+        task()
     except KeyboardInterrupt as err:  # every output is published whole, so nothing half-written is left
         print("interrupted", file=sys.stderr)
         sys.exit(interrupts.exit_code(err))

@@ -1,7 +1,9 @@
-"""Simulate stage CLI.
+"""Simulate stage CLI (a Hydra app: `--help` lists every experiment, `--cfg job`, `-p KEY`, `-m` as documented).
 
     python -m pipeline experiment=<slug>/<name> [key=value ...]       one experiment, one MCAP per case
     python -m pipeline -m experiment=<slug>/<name> key=a,b,c           a sweep, run in parallel (joblib)
+    python -m pipeline --help                                          every experiment, one line each
+    python -m pipeline experiment=<slug>/<name> --cfg job              the resolved config, nothing run
 """
 
 from __future__ import annotations
@@ -16,16 +18,18 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 
 def main() -> None:
     from pipeline.core.checks import BadInput, preflight
+    from pipeline.core.cli import register_help_resolver, runs_nothing, split_args
 
-    # Hydra wants its flags before or after all overrides; accept -m anywhere (dvc.yaml appends it).
-    multirun = [a for a in sys.argv[1:] if a in ("-m", "--multirun")]
-    sys.argv[1:] = multirun + [a for a in sys.argv[1:] if a not in multirun]
+    # Hydra wants its flags before all overrides; accept them anywhere (dvc.yaml appends -m).
+    flags, overrides = split_args(sys.argv[1:])
+    sys.argv[1:] = flags + overrides
 
-    try:
-        preflight(sys.argv[1:])
-    except BadInput as err:
-        print(f"error: {err}", file=sys.stderr)
-        sys.exit(2)
+    if not runs_nothing(flags):
+        try:
+            preflight(overrides)
+        except BadInput as err:
+            print(f"error: {err}", file=sys.stderr)
+            sys.exit(2)
 
     import hydra
     from hydra.core.hydra_config import HydraConfig
@@ -35,6 +39,7 @@ def main() -> None:
     from pipeline.core.experiment import CONF_DIR
     from pipeline.core.runner import simulate
 
+    register_help_resolver()
     stage_pid = os.getpid()
 
     @hydra.main(config_path=str(CONF_DIR), config_name="config", version_base=None)

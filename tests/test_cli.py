@@ -45,6 +45,30 @@ def test_analysis_bad_input(data_dir, args, names):
     assert not data_dir.exists()
 
 
+@pytest.mark.parametrize("module", ["pipeline", "analysis"])
+def test_help_lists_every_experiment(module, data_dir):
+    from pipeline.core.experiment import experiment_descriptions
+
+    proc = run_cli(module, "--help")
+    assert proc.returncode == 0, proc.stderr
+    for name, text in experiment_descriptions().items():
+        assert name in proc.stdout and text in proc.stdout
+    assert not data_dir.exists()
+
+
+@pytest.mark.parametrize(("module", "args", "shown"), [
+    ("pipeline", ["experiment=ur5-ik-fsm/tables", "--cfg", "job"], "table2:"),
+    ("pipeline", ["--cfg", "job", "-p", "system.geometry", "experiment=ur5-ik-fsm/tables"], "a2: 0.425"),
+    ("analysis", ["stage=report", "--cfg", "job"], "stage: report"),
+    ("analysis", ["--cfg", "job", "-p", "stage"], "all"),
+])
+def test_hydra_flags_take_their_value_after_a_space(module, args, shown, data_dir):
+    proc = run_cli(module, *args, f"data_dir={data_dir}")
+    assert proc.returncode == 0, proc.stderr
+    assert shown in proc.stdout
+    assert not data_dir.exists()   # printing the config runs nothing
+
+
 def test_sweep_runs_one_file_per_point_in_parallel(data_dir):
     proc = run_cli("pipeline", "-m", "experiment=ur5-ik-fsm/singular-paths", *SHORT_PATH,
                    "scenario.algorithms=[alg2]", "execute.bandwidth_hz=6,10", f"data_dir={data_dir}")

@@ -8,6 +8,7 @@ import pandas as pd
 from pipeline.core.runlog import read_run, run_files
 
 from .conftest import run_cli
+from .test_report import assert_tables_whole, markdown_rows_whole
 
 
 def test_pipeline_to_report(data_dir):
@@ -40,6 +41,17 @@ def test_pipeline_to_report(data_dir):
     assert ur5.loc[ur5["status"] != "not-reproducible", "pipeline_value"].notna().all()
     assert "ur5-ik-fsm" in (report / "index.md").read_text()
     assert list((data_dir / "figures/ur5-ik-fsm/singular-paths").glob("*.png"))
+    assert list((data_dir / "figures/ur5-ik-fsm/singular-paths").glob("*.svg"))
+    # every page of the report: every table row has as many cells as its header, nothing cites the spec
+    pages = sorted(report.glob("*.html"))
+    assert len(pages) >= 10
+    for page in pages:
+        html = page.read_text()
+        assert_tables_whole(html, page.name)
+        markdown_rows_whole(page.with_suffix(".md").read_text(), page.with_suffix(".md").name)
+        assert "spec §" not in html
+    index = (report / "index.html").read_text()
+    assert all(s in index for s in ("match", "close", "not run", "misses still open", "self-consistency"))
 
     run = read_run(run_files(data_dir / "runs/ur5-ik-fsm/singular-paths")[0])
     assert run.metadata["slug"] == "ur5-ik-fsm" and run.metadata["git_revision"]

@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from analysis.papers.partial_lagrangian import _decay_rate, paper_term_counts, slope, static_equilibrium
+from analysis.papers.partial_lagrangian.metrics import _decay_rate, paper_term_counts, slope, static_equilibrium
 from pipeline.papers.partial_lagrangian import Gains, MujocoChain, column_mass_bias, dynamics, energies, simulate
 from pipeline.papers.partial_lagrangian.chain import PRISMATIC, REVOLUTE, double_pendulum, gravity_torque, planar_chain
 from pipeline.papers.partial_lagrangian.lagrangian import FORMS, column, listing_a1_step, partial_lagrangian

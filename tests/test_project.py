@@ -11,7 +11,7 @@ import yaml
 from analysis.core.stages import PAPERS_DIR, analyzed_slugs, paper_package
 from analysis.core.targets import Tolerance, judge, load_targets
 from analysis.core.units import convert
-from pipeline.core.experiment import available_experiments, module_name, paper_module
+from pipeline.core.experiment import available_experiments, experiment_descriptions, module_name, paper_module
 
 from .conftest import ROOT
 
@@ -24,6 +24,9 @@ def test_every_experiment_is_a_dvc_stage_and_has_code():
         slug, name = experiment.split("/")
         assert name in paper_module(slug).EXPERIMENTS
         assert name in paper_package(slug).ANALYSES
+    # `--help` lists every experiment with its one-line description
+    for experiment, text in experiment_descriptions().items():
+        assert text != "(no description)" and "\n" not in text and len(text) <= 140, experiment
 
 
 @pytest.mark.parametrize("slug", analyzed_slugs())

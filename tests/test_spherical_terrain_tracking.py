@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from omegaconf import OmegaConf
 
-from analysis.papers.spherical_terrain import convergence_time
+from analysis.papers.spherical_terrain.metrics import convergence_time
 from pipeline.core.checks import compose_config
 from pipeline.papers.spherical_terrain import CosineTerrain, GainTable, Model, circle, controls, diamond, simulate
 from pipeline.papers.spherical_terrain.experiments import run_batch

@@ -7,6 +7,7 @@ import json
 
 import pandas as pd
 
+from analysis.core.sections import Section, Table
 from analysis.core.units import convert
 
 
@@ -26,14 +27,15 @@ def machine_of(runs: pd.DataFrame, experiment: str) -> str:
 
 
 def compute_time_section(title: str, metrics: pd.DataFrame, run_id: str, rows: list[tuple[str, str, str]],
-                         machine: str, unit: str = "us", note: str = "") -> str:
-    """Markdown table: one row per (label, metric name, paper's figure as text)."""
+                         machine: str, unit: str = "us", note: str = "") -> Section:
+    """A report section with one row per (label, metric name, paper's figure as text), placed with the
+    compute-time targets."""
     def value(metric: str) -> float:
         hit = metrics[(metrics["run_id"] == run_id) & (metrics["metric"] == metric)]
         return convert(float(hit["value"].iloc[0]), hit["unit"].iloc[0], unit) if not hit.empty else float("nan")
 
     table = pd.DataFrame([{"algorithm": label, f"median [{unit}]": value(f"{name}.median"),
                            f"p95 [{unit}]": value(f"{name}.p95"), "paper": paper} for label, name, paper in rows])
-    return (f"## {title}\n\n" + table.to_markdown(index=False, floatfmt=".3g")
-            + f"\n\nMeasured on {machine}, single thread, after warm-up (median and p95 over every timed call)."
-            + (f" {note}" if note else ""))
+    return Section(title, Table(table, ".3g"),
+                   f"Measured on {machine}, single thread, after warm-up (median and p95 over every timed call)."
+                   + (f" {note}" if note else ""), category="compute times")

@@ -1,31 +1,107 @@
 """The report: one summary over all papers, one page per paper, every target in one CSV.
 
-    <data_dir>/report/index.md + index.html     papers × {trajectories, tracking errors, force errors,
-                                                compute times}: targets matched / close / missed / n.r.
-    <data_dir>/report/<slug>.md + .html         paper vs pipeline, figures, extra tables, assumptions, errata
-    <data_dir>/report/targets.csv               slug,target_id,quantity,where,paper_value,pipeline_value,
-                                                unit,mode,tolerance,status
+    <data_dir>/report/index.html + index.md     papers × {trajectories, tracking errors, force errors, compute
+                                                times}: targets per status; misses still `open`; the papers'
+                                                self-consistency checks apart; what every status means
+    <data_dir>/report/<slug>.html + .md         paper vs pipeline per category with its figures, the paper against
+                                                itself, runs and the commands that regenerate them, the paper's
+                                                report sections, assumptions, errata
+    <data_dir>/report/targets.csv               every target: TARGETS_CSV_COLUMNS (below)
+
+Pages are rendered from the Jinja2 templates in analysis/core/templates/: HTML escapes every value by
+construction, Markdown cells go through the `cell` filter (a `|` or a line break cannot break a row).
+
+What a paper declares for its page, in `analysis/papers/<module>/paper.yaml`:
+
+    slug, title, authors, venue, doi (bare, e.g. 10.3390/robotics11060137), summary
+    assumptions: list of {what, choice, config}        what the paper leaves out, and what we chose
+    errata:      list of {where, printed, corrected, config}
+    figures:                                           every figure its analysis saves, keyed by
+      <experiment>/<file stem>:                        the path under data/figures/<slug>/ without extension
+        paper: Fig. 8                                  the paper figure or table it regenerates (null: none)
+        caption: Grasping force during a 40° rotation  one or two sentences: what is drawn, what to look for
+        section: force errors                          a target category (the figure is placed after that
+                                                       category's targets) or `further results`
+    The key may be a glob (`singular-paths/*-near`); the first matching key wins, and `{name}` in a caption is
+    the file stem. An undeclared figure is shown under "Further results" and named on stderr.
+
+The columns of targets.csv (one row per target of every paper):
+
+    slug, target_id, category, quantity, where   the paper and the target (analysis/core/targets.py)
+    paper_value, op                              the paper's printed value and how it is compared
+    pipeline_value                               the pipeline's value in the paper's unit (empty: none)
+    deviation, relative_deviation                pipeline − paper, and that over |paper|
+    unit, mode, basis, tolerance                 as declared in the paper's targets.csv
+    status                                       match | close | consistent | miss | not run | not-reproducible,
+                                                 or agrees | disagrees for a consistency row
+    cause                                        of a miss, close or disagreement (targets.py: CAUSE_MEANING)
+    note                                         the rule, assumption or evidence (+ why a value is absent)
+    experiment, run                              where the pipeline value comes from (data/runs/<slug>/...)
 """
 
 from __future__ import annotations
 
+import fnmatch
 import math
 import os
+import re
+import sys
+from collections import Counter
+from functools import cache
 from pathlib import Path
 
 import pandas as pd
 import yaml
+from jinja2 import Environment, PackageLoader, StrictUndefined
 from markdown_it import MarkdownIt
+from markupsafe import Markup
 
-from analysis.core.targets import CATEGORIES, STATUSES
+from analysis.core.sections import Section
+from analysis.core.targets import CATEGORIES, CAUSE_MEANING, CAUSES, STATUS_MEANING, STATUSES
 from pipeline.core import files, provenance
 
 TARGETS_CSV_COLUMNS = ["slug", "target_id", "category", "quantity", "where", "paper_value", "op", "pipeline_value",
                        "deviation", "relative_deviation", "unit", "mode", "basis", "tolerance", "status", "cause",
                        "note", "experiment", "run"]
-STATUS_MARK = {"match": "✅ match", "close": "🟡 close", "consistent": "🔵 consistent", "miss": "❌ miss",
-               "not run": "· not run", "not-reproducible": "⚪ n.r.", "agrees": "✅ agrees",
-               "disagrees": "❌ disagrees"}
+FURTHER = "further results"
+SELF_STATUSES = ("agrees", "disagrees", "not run")
+ROOT = Path(__file__).resolve().parents[2]
+OP_SIGN = {"==": "", "<": "< ", "<=": "≤ ", ">": "> ", ">=": "≥ "}
+STATUS_RANK = {s: i for i, s in enumerate(("miss", "disagrees", "close", "consistent", "not run", "match", "agrees",
+                                           "not-reproducible"))}
+
+
+# -- rendering ---------------------------------------------------------------------------------------------------
+
+
+def _md_cell(value) -> str:
+    """A Markdown table cell: a `|` would end the cell and a line break the row."""
+    return re.sub(r"\s*\n\s*", " ", str(value)).replace("|", "\\|")
+
+
+_prose = MarkdownIt("commonmark", {"html": False}).enable("table")
+
+
+@cache
+def _environments() -> tuple[Environment, Environment]:
+    html = Environment(loader=PackageLoader("analysis.core", "templates"), autoescape=True, undefined=StrictUndefined,
+                       trim_blocks=False, lstrip_blocks=False)
+    html.filters["markdown"] = lambda text: Markup(_prose.render(text).replace('.md"', '.html"'))
+    md = Environment(loader=PackageLoader("analysis.core", "templates"), autoescape=False,
+                     undefined=StrictUndefined, keep_trailing_newline=True)
+    md.filters["cell"] = _md_cell
+    return html, md
+
+
+def render(template: str, **context) -> str:
+    """Render `<template>.html.j2` or `<template>.md.j2` (by the name's suffix)."""
+    html, md = _environments()
+    env = html if template.endswith(".html.j2") else md
+    text = env.get_template(template).render(cause_meaning=CAUSE_MEANING, **context)
+    return re.sub(r"\n{3,}", "\n\n", text) if env is md else text
+
+
+# -- values --------------------------------------------------------------------------------------------------------
 
 
 def _fmt(x) -> str:
@@ -34,112 +110,207 @@ def _fmt(x) -> str:
     return str(x)
 
 
-def _md_table(frame: pd.DataFrame) -> str:
-    if frame.empty:
-        return "_(none)_"
-    return frame.map(_fmt).to_markdown(index=False)
+def _signed(x: float, relative: bool = False) -> str:
+    if isinstance(x, float) and math.isnan(x):
+        return ""
+    return f"{100 * x:+.3g} %" if relative else f"{x:+.4g}"
+
+
+def anchor(*parts: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "-", "-".join(parts)).strip("-")
 
 
 def counts(evaluated: pd.DataFrame) -> dict[str, dict[str, int]]:
-    """category -> status -> count."""
-    return {cat: {s: int(((evaluated["category"] == cat) & (evaluated["status"] == s)).sum()) for s in STATUSES}
+    """category -> status -> count of reproduction targets (consistency rows apart)."""
+    live = evaluated[evaluated["mode"] != "consistency"]
+    return {cat: {s: int(((live["category"] == cat) & (live["status"] == s)).sum()) for s in STATUSES}
             for cat in CATEGORIES}
 
 
-def _cell(c: dict[str, int]) -> str:
-    if not sum(c.values()):
-        return "–"
-    return f"{c['match']} / {c['close']} / {c['miss']} / {c['not-reproducible']}"
+# -- commands and run files -----------------------------------------------------------------------------------------
 
 
-def paper_page(info: dict, evaluated: pd.DataFrame, runs: pd.DataFrame, sections: list[str],
-               figures: list[Path], report_dir: Path) -> str:
-    c = counts(evaluated)
-    lines = [f"# {info['title']}", "", f"`{info['slug']}` — {info['authors']}, *{info['venue']}*"
-             + (f", doi:{info['doi']}" if info.get("doi") else ""), ""]
-    if info.get("summary"):
-        lines += [info["summary"].strip(), ""]
-    lines += ["## Summary", "", "matched / close / missed / not reproducible", "",
-              "| " + " | ".join(CATEGORIES) + " |", "|" + "---|" * len(CATEGORIES),
-              "| " + " | ".join(_cell(c[k]) for k in CATEGORIES) + " |", ""]
-    lines += ["## Runs", ""]
-    if runs.empty:
-        lines += ["No runs on disk yet: `python -m pipeline experiment=<slug>/<name>` makes them.", ""]
-    else:
-        table = runs.groupby("experiment").agg(runs=("run_id", "size"), failed=("ok", lambda s: int((~s).sum())))
-        lines += [table.reset_index().to_markdown(index=False), ""]
-        failed = runs[~runs["ok"]]
-        if not failed.empty:
-            lines += ["Failed runs (recorded, not hidden):", "",
-                      _md_table(failed[["experiment", "run_id", "status"]]), ""]
-    lines += ["## Paper vs pipeline", "",
-              "Every pipeline value is computed from the runs on disk; the paper's value is copied from the paper. "
-              "Tolerance rules and statuses: `analysis/core/targets.py`.", ""]
-    for category in CATEGORIES:
-        part = evaluated[evaluated["category"] == category]
-        if part.empty:
-            continue
-        shown = part.assign(status=part["status"].map(STATUS_MARK))[
-            ["target_id", "quantity", "where", "paper_value", "op", "pipeline_value", "unit", "mode", "tolerance",
-             "status", "cause", "note"]]
-        lines += [f"### {category.capitalize()}", "", _md_table(shown), ""]
-    for section in sections:
-        lines += [section.strip(), ""]
-    if figures:
-        lines += ["## Figures", ""]
-        for fig in figures:
-            rel = os.path.relpath(fig, report_dir)
-            lines += [f"![{fig.stem}]({rel})", ""]
-    for key, title in (("assumptions", "Assumptions (what the paper does not give)"),
-                       ("errata", "Errata (misprints found, and what we run)")):
-        items = info.get(key) or []
-        if items:
-            lines += [f"## {title}", "", _md_table(pd.DataFrame(items)), ""]
-    return "\n".join(lines)
+@cache
+def _dvc_args() -> dict[str, str]:
+    """experiment id -> the extra arguments of its simulate stage in dvc.yaml (a sweep's grid)."""
+    path = ROOT / "dvc.yaml"
+    if not path.is_file():
+        return {}
+    entries = yaml.safe_load(path.read_text())["vars"][0]["experiments"]
+    return {f"{e['slug']}/{e['name']}": e.get("args", "") for e in entries.values()}
 
 
-def index_page(papers: list[tuple[dict, pd.DataFrame, pd.DataFrame]]) -> str:
-    lines = ["# Reproduction report", "",
-             "Each cell: targets matched / close / missed / not reproducible. A target is one number, bound or "
-             "claim the paper reports; the pipeline's value is computed from the simulated runs.", "",
-             "| paper | " + " | ".join(CATEGORIES) + " | runs (failed) |", "|---|" + "---|" * (len(CATEGORIES) + 1)]
-    total = {k: dict.fromkeys(STATUSES, 0) for k in CATEGORIES}
-    for info, evaluated, runs in papers:
-        c = counts(evaluated)
-        for k in CATEGORIES:
-            for s in STATUSES:
-                total[k][s] += c[k][s]
-        n_failed = int((~runs["ok"]).sum()) if not runs.empty else 0
-        lines.append(f"| [{info['slug']}]({info['slug']}.md) | " + " | ".join(_cell(c[k]) for k in CATEGORIES)
-                     + f" | {len(runs)} ({n_failed}) |")
-    lines.append("| **all** | " + " | ".join(_cell(total[k]) for k in CATEGORIES) + " | |")
-    m = provenance.machine()
-    lines += ["", f"Code revision `{provenance.git_revision()}`. Compute times were measured on: {m['cpu']}, "
-              f"{m['logical_cores']} logical cores, {m['system']}, Python {m['python']} (medians over repeats; "
-              "see each paper's compute-time table).", "",
-              "All targets: [targets.csv](targets.csv)."]
-    return "\n".join(lines)
+def commands(experiment_id: str) -> tuple[str, str]:
+    """The commands that regenerate an experiment's runs, then its metrics and figures (and the report)."""
+    args = _dvc_args().get(experiment_id, "")
+    multirun = "-m " if args.startswith("-m ") else ""
+    simulate = f"python -m pipeline {multirun}experiment={experiment_id} {args.removeprefix('-m ')}".strip()
+    return simulate, f"python -m analysis experiment={experiment_id}"
 
 
-_CSS = """body{font-family:system-ui,sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;line-height:1.4}
-table{border-collapse:collapse;font-size:0.85em;margin:0.5em 0}td,th{border:1px solid #ccc;padding:2px 6px}
-th{background:#f3f3f3}img{max-width:100%}code{background:#f5f5f5;padding:0 3px}"""
+def _run_href(data_dir: Path, report_dir: Path, slug: str, experiment: str, run: str) -> str:
+    folder = data_dir / "runs" / slug / experiment
+    file = folder / f"{run}.mcap"
+    return os.path.relpath(file if file.is_file() else folder, report_dir)
 
 
-def to_html(markdown: str, title: str) -> str:
-    body = MarkdownIt("commonmark").enable("table").render(markdown)
-    body = body.replace('.md"', '.html"')
-    return (f"<!doctype html><html><head><meta charset='utf-8'><title>{title}</title><style>{_CSS}</style>"
-            f"</head><body>{body}</body></html>")
-
-
-def write_page(path: Path, markdown: str, title: str) -> None:
-    files.write_text(path, markdown + "\n")
-    files.write_text(path.with_suffix(".html"), to_html(markdown, title))
+# -- one paper ------------------------------------------------------------------------------------------------------
 
 
 def load_paper_info(package_dir: Path) -> dict:
     return yaml.safe_load((package_dir / "paper.yaml").read_text())
+
+
+def _target_rows(part: pd.DataFrame, data_dir: Path, report_dir: Path) -> list[dict]:
+    rows = []
+    for t in part.itertuples(index=False):
+        paper = t.paper_value
+        rows.append({
+            "target_id": t.target_id, "anchor": anchor("t", t.target_id), "status": t.status,
+            "status_rank": STATUS_RANK.get(t.status, 99), "cause": t.cause, "quantity": t.quantity, "where": t.where,
+            "paper": f"{OP_SIGN.get(t.op, '')}{paper}" if paper != "" else "", "paper_sort": paper,
+            "pipeline": _fmt(t.pipeline_value), "pipeline_sort": _fmt(t.pipeline_value),
+            "deviation": _signed(t.deviation), "relative": _signed(t.relative_deviation, relative=True),
+            "relative_sort": "" if math.isnan(t.relative_deviation) else f"{abs(t.relative_deviation):.6g}",
+            "unit": t.unit, "tolerance": t.tolerance, "basis": t.basis, "mode": t.mode, "note": t.note,
+            "experiment": t.experiment, "run": t.run,
+            "run_href": _run_href(data_dir, report_dir, t.slug, t.experiment, t.run) if t.experiment else "",
+            "command_anchor": anchor("run", t.experiment) if t.experiment else ""})
+    return rows
+
+
+def figure_entries(info: dict, figures: list[Path], report_dir: Path) -> list[dict]:
+    """Each saved figure with its declaration from paper.yaml (paper figure, caption, section)."""
+    declared = info.get("figures") or {}
+    entries = []
+    for png in figures:
+        key = f"{png.parent.name}/{png.stem}"
+        spec = next((v for k, v in declared.items() if fnmatch.fnmatchcase(key, k)), None)
+        if spec is None:
+            print(f"report: {info['slug']}: figure {key} is not declared in paper.yaml (figures:)", file=sys.stderr)
+            spec = {"paper": None, "caption": "(not declared in paper.yaml)", "section": FURTHER}
+        svg = png.with_suffix(".svg")
+        entries.append({"experiment": png.parent.name, "name": png.stem, "anchor": anchor("fig", key),
+                        "paper": spec.get("paper"), "caption": str(spec.get("caption", "")).format(name=png.stem),
+                        "section": spec.get("section", FURTHER), "png": os.path.relpath(png, report_dir),
+                        "svg": os.path.relpath(svg if svg.is_file() else png, report_dir)})
+    return entries
+
+
+def _sections(sections: list[Section | str]) -> list[Section]:
+    """A paper's report sections; a plain Markdown string (the former API) becomes one untitled block."""
+    out = []
+    for s in sections:
+        if isinstance(s, str):
+            title, _, text = s.strip().partition("\n")
+            s = Section(title.lstrip("# ").strip(), text)
+        s.anchor = anchor("sec", s.title)[:60]
+        out.append(s)
+    return out
+
+
+def paper_context(info: dict, evaluated: pd.DataFrame, runs: pd.DataFrame, sections: list[Section | str],
+                  figures: list[Path], data_dir: Path, report_dir: Path) -> dict:
+    slug = info["slug"]
+    reproduction = evaluated[evaluated["mode"] != "consistency"]
+    consistency = evaluated[evaluated["mode"] == "consistency"]
+    figs = figure_entries(info, figures, report_dir)
+    secs = _sections(sections)
+    c = counts(evaluated)
+    shown_statuses = [s for s in STATUSES if any(c[k][s] for k in CATEGORIES)] or ["match"]
+    categories = []
+    for category in CATEGORIES:
+        part = reproduction[reproduction["category"] == category]
+        cat_figs = [f for f in figs if f["section"] == category]
+        cat_secs = [s for s in secs if s.category == category]
+        if part.empty and not cat_figs and not cat_secs:
+            continue
+        categories.append({"title": category.capitalize(), "anchor": anchor(category),
+                           "targets": _target_rows(part, data_dir, report_dir), "figures": cat_figs,
+                           "sections": cat_secs})
+    placed = {c["title"].lower() for c in categories}
+    further = {"figures": [f for f in figs if f["section"] not in placed],
+               "sections": [s for s in secs if s.category not in placed]}
+    run_rows, failed_runs = [], []
+    if not runs.empty:
+        for experiment, group in runs.groupby("experiment"):
+            simulate, analyze = commands(f"{slug}/{experiment}")
+            run_rows.append({"experiment": experiment, "anchor": anchor("run", experiment), "runs": len(group),
+                             "failed": int((~group["ok"].astype(bool)).sum()), "simulate": simulate,
+                             "analyze": analyze, "href": os.path.relpath(data_dir / "runs" / slug / experiment,
+                                                                         report_dir)})
+        failed_runs = runs[~runs["ok"].astype(bool)][["experiment", "run_id", "status"]].to_dict("records")
+    causes = Counter(reproduction.loc[reproduction["status"].isin(["miss", "close"]), "cause"])
+    toc = [("summary", "Summary"), ("runs", "Runs and commands")]
+    toc += [(c["anchor"], f"Paper vs pipeline: {c['title'].lower()}") for c in categories]
+    if not consistency.empty:
+        toc.append(("self-consistency", "The paper against itself"))
+    if further["figures"] or further["sections"]:
+        toc.append(("further", "Further results"))
+    notes = [("assumptions", "Assumptions (what the paper does not give)", info.get("assumptions") or []),
+             ("errata", "Errata (misprints found, and what we run)", info.get("errata") or [])]
+    toc += [(key, title.split(" (")[0]) for key, title, rows in notes if rows]
+    status_counts = Counter(evaluated["status"])
+    return {
+        "title": f"{slug}: {info['title']}", "info": {**info, "summary": str(info.get("summary", "")).strip()},
+        "toc": toc, "summary": {"statuses": shown_statuses,
+                                "rows": [{"category": k, "counts": c[k]} for k in CATEGORIES if sum(c[k].values())],
+                                "consistency": {s: n for s in SELF_STATUSES
+                                                if (n := int((consistency["status"] == s).sum()))},
+                                "causes": {k: causes[k] for k in CAUSES if causes[k]}},
+        "runs": run_rows, "failed_runs": failed_runs, "categories": categories,
+        "consistency": _target_rows(consistency, data_dir, report_dir), "further": further, "notes": notes,
+        "status_counts": [(s, status_counts[s]) for s in (*STATUSES, *SELF_STATUSES[:2]) if status_counts[s]],
+        "revision": provenance.git_revision(),
+    }
+
+
+# -- the index ----------------------------------------------------------------------------------------------------
+
+
+def _paper_row(info: dict, evaluated: pd.DataFrame, runs: pd.DataFrame) -> dict:
+    c = counts(evaluated)
+    live = evaluated[evaluated["mode"] != "consistency"]
+    misses = live[live["status"] == "miss"]
+    self_check = evaluated.loc[evaluated["mode"] == "consistency", "status"]
+    return {"slug": info["slug"], "title": info["title"],
+            "cells": {k: [(s, c[k][s]) for s in STATUSES if c[k][s]] for k in CATEGORIES},
+            "open": int((misses["cause"] == "open").sum()), "misses": len(misses),
+            "consistency": [(s, int((self_check == s).sum())) for s in SELF_STATUSES if (self_check == s).any()],
+            "runs": len(runs), "failed": int((~runs["ok"].astype(bool)).sum()) if not runs.empty else 0}
+
+
+def index_context(papers: list[tuple[dict, pd.DataFrame, pd.DataFrame]]) -> dict:
+    rows = [_paper_row(*p) for p in papers]
+    total = {"cells": {k: [] for k in CATEGORIES}, "open": sum(r["open"] for r in rows),
+             "misses": sum(r["misses"] for r in rows), "runs": sum(r["runs"] for r in rows),
+             "failed": sum(r["failed"] for r in rows), "consistency": []}
+    for k in CATEGORIES:
+        n = Counter()
+        for r in rows:
+            n.update(dict(r["cells"][k]))
+        total["cells"][k] = [(s, n[s]) for s in STATUSES if n[s]]
+    n = Counter()
+    for r in rows:
+        n.update(dict(r["consistency"]))
+    total["consistency"] = [(s, n[s]) for s in SELF_STATUSES if n[s]]
+    return {"title": "Reproduction report", "papers": rows, "total": total, "categories": CATEGORIES,
+            "status_meaning": STATUS_MEANING, "machine": provenance.machine(), "revision": provenance.git_revision()}
+
+
+# -- writing ---------------------------------------------------------------------------------------------------------
+
+
+def write_paper_pages(report_dir: Path, context: dict) -> None:
+    slug = context["info"]["slug"]
+    files.write_text(report_dir / f"{slug}.html", render("paper.html.j2", **context))
+    files.write_text(report_dir / f"{slug}.md", render("paper.md.j2", **context))
+
+
+def write_index(report_dir: Path, context: dict) -> Path:
+    files.write_text(report_dir / "index.html", render("index.html.j2", **context))
+    files.write_text(report_dir / "index.md", render("index.md.j2", **context))
+    return report_dir / "index.html"
 
 
 def write_targets_csv(evaluated: list[pd.DataFrame], path: Path) -> pd.DataFrame:

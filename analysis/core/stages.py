@@ -4,7 +4,14 @@ A paper's analysis package `analysis.papers.<module>` holds `paper.yaml` (title,
 `targets.csv` (its reported numbers, see analysis/core/targets.py) and exports
 
     ANALYSES: dict[str, Callable[[list[Run], Figures], pd.DataFrame]]   # experiment name -> tidy metrics
-    report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]   # optional extras
+    report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]   # optional extras
+
+Its `__init__.py` only imports and names these; the work lives in modules named for what they do:
+`metrics.py` (constants, what is read from a run, metric computations), `figures.py` (plots; a value the paper
+prints is drawn from targets.csv with analysis.core.targets.paper_value, labelled "paper"), `analyses.py` (one
+analysis per experiment, and ANALYSES) and `sections.py` (report_sections: `Section`s of prose and `Table`s,
+analysis/core/sections.py). The figures each analysis saves are declared in paper.yaml with their caption, the
+paper figure they regenerate and their place on the page (analysis/core/report.py says how).
 """
 
 from __future__ import annotations
@@ -93,14 +100,12 @@ def write_report(data_dir: Path) -> Path:
         evaluated = evaluate(slug, load_targets(package_dir / "targets.csv"), metrics, runs)
         sections = package.report_sections(metrics, runs) if hasattr(package, "report_sections") and metrics else []
         figures = sorted((data_dir / "figures" / slug).glob("*/*.png"))
-        report.write_page(report_dir / f"{slug}.md",
-                          report.paper_page(info, evaluated, runs, sections, figures, report_dir), slug)
+        report.write_paper_pages(report_dir, report.paper_context(info, evaluated, runs, sections, figures,
+                                                                  data_dir, report_dir))
         pages.append((info, evaluated, runs))
         all_evaluated.append(evaluated)
     report.write_targets_csv(all_evaluated, report_dir / "targets.csv")
-    index = report_dir / "index.md"
-    report.write_page(index, report.index_page(pages), "Reproduction report")
-    return index
+    return report.write_index(report_dir, report.index_context(pages))
 
 
 def run(data_dir: Path, experiment: str | None, stage: str) -> int:

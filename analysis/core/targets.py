@@ -5,36 +5,47 @@ Each paper has `analysis/papers/<module>/targets.csv` with one row per reported 
     target_id, category, quantity, where, value, unit, mode, op, tolerance, basis, cause,
     experiment, run, metric, note
 
+- `target_id`: unique in the paper (letters, digits, `.`, `-`, `_`); the report anchors each row by it
 - `category`: trajectories | tracking errors | force errors | compute times (the report's summary columns)
+- `quantity`, `where`: what the number is, and where the paper prints it (Table 2, KD; Fig. 9; Sec. 5)
+- `value`, `unit`: the paper's number as printed, in the paper's unit (mm, deg, ms, %, ...)
 - `mode`: exact | relative | bound | qualitative | consistency | not reproducible. `consistency` checks the
   paper against itself (its printed numbers against each other): never a reproduction.
 - `op`: how `value` is compared: `==` (within tolerance), or `<`, `<=`, `>`, `>=` (a bound or ranking)
 - `tolerance`: `<x>` absolute, `<x> rel` relative, `<x> wrap` absolute on angles modulo 2π (±π equal);
-  for an inequality, the margin within which a miss counts as close
+  for an inequality, the margin by which it may fail and still count as close
 - `basis`: what the pipeline value is computed from: `simulation` (a simulated system), `algorithm` (the
   paper's algorithm run on its inputs: IK, synthesis, planning, …) or `paper` (arithmetic on the paper's
   own printed numbers). A `paper` basis goes with mode `consistency`, and only with it.
-- `cause`: why a target misses or is only close, when known: paper-inconsistent | parameter-missing |
-  hardware-only | model-limitation | open. The note names the numbers, parameter or missing model part.
-  A miss or close without a stated cause is reported as `open` (not yet understood).
-- `experiment`, `run`, `metric`: where the pipeline's value is found in data/metrics/<slug>/<experiment>.parquet;
-  `metric` is in SI; `unit` is the paper's, and the pipeline value is converted to it for the comparison
+- `cause`: why a target misses or is only close (declare it for every target you know to miss or be close):
+    paper-inconsistent  the paper's own numbers contradict each other (the note names them)
+    parameter-missing   the value depends on a parameter the paper does not give (the note names it)
+    hardware-only       only the authors' hardware can give it
+    model-limitation    our model lacks something the value depends on (the note names what)
+    open                not yet understood
+  A miss or close without a declared cause is reported as `open`.
+- `experiment`, `run`, `metric`: where the pipeline's value is found in data/metrics/<slug>/<experiment>.parquet
+  (`run` is a run id, or the id of an aggregate the analysis writes, e.g. `surface`); `metric` is in SI;
+  `unit` is the paper's, and the pipeline value is converted to it for the comparison
+- `note`: the rule, assumption or evidence behind the row; for a miss or close, the evidence for its cause
 - `qualitative` targets compare a metric that is 1 when the stated rule holds, 0 when not
 
-Statuses of a reproduction (modes exact, relative, bound, qualitative):
-  match       within the tolerance, or the inequality holds
-  close       outside the tolerance but within CLOSE_FACTOR × it (an inequality: within its margin)
-  consistent  the paper's value lies inside the band the pipeline value spans over a disclosed sweep of a
-              parameter the paper omits (never merged with match)
-  miss        farther off, or no pipeline value although the experiment ran (a failed run says why)
-  not run     the target's experiment has no runs in this data_dir
+Statuses (STATUS_MEANING says each in one sentence; the report prints them):
+  match        within the tolerance, or the inequality holds
+  close        outside the tolerance but within CLOSE_FACTOR × it (an inequality: fails by at most its margin)
+  consistent   the paper's value lies inside the band the pipeline value spans over a disclosed sweep of a
+               parameter the paper omits (never merged with match; not assigned yet)
+  miss         farther off, or no pipeline value although its run was made (a failed run says why)
+  not run      the target's run is not in this data_dir (its experiment, or that run of it, was not run)
+  not-reproducible  hardware only: nothing to compute
 Statuses of a `consistency` row: agrees / disagrees (the same rule as match / miss), or not run.
-A `not reproducible` row (hardware only) has status not-reproducible.
 """
 
 from __future__ import annotations
 
+import functools
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -50,6 +61,25 @@ CAUSES = ("paper-inconsistent", "parameter-missing", "hardware-only", "model-lim
 STATUSES = ("match", "close", "consistent", "miss", "not run", "not-reproducible")
 CONSISTENCY_STATUSES = ("agrees", "disagrees", "not run")
 CLOSE_FACTOR = 2.0  # `close`: outside the tolerance, within twice it
+STATUS_MEANING = {
+    "match": "the pipeline's value is within the tolerance of the paper's, or the paper's inequality holds.",
+    "close": f"outside the tolerance but within {CLOSE_FACTOR:g}× it (an inequality: fails by at most its margin).",
+    "consistent": "the paper's value lies inside the band our value spans over a disclosed sweep of a parameter "
+                  "the paper omits.",
+    "miss": f"farther off than {CLOSE_FACTOR:g}× the tolerance, or no value although the run was made "
+            "(a failed run says why).",
+    "not run": "the run this target needs is not in this data_dir; run its experiment to judge it.",
+    "not-reproducible": "only the authors' hardware can give this number; nothing to compute.",
+    "agrees": "a consistency check: the paper's printed numbers agree with each other (not a reproduction).",
+    "disagrees": "a consistency check: the paper's printed numbers contradict each other (not a reproduction).",
+}
+CAUSE_MEANING = {
+    "paper-inconsistent": "the paper's own numbers contradict each other",
+    "parameter-missing": "the value depends on a parameter the paper does not give",
+    "hardware-only": "only the authors' hardware can give it",
+    "model-limitation": "our model lacks something the value depends on",
+    "open": "not yet understood",
+}
 COLUMNS = ["target_id", "category", "quantity", "where", "value", "unit", "mode", "op", "tolerance", "basis",
            "cause", "experiment", "run", "metric", "note"]
 
@@ -92,7 +122,24 @@ def load_targets(path: Path) -> pd.DataFrame:
     dupes = targets["target_id"][targets["target_id"].duplicated()].tolist()
     if dupes:
         raise ValueError(f"{path}: duplicate target ids {dupes}")
+    odd = [t for t in targets["target_id"] if not re.fullmatch(r"[A-Za-z0-9._-]+", t)]
+    if odd:
+        raise ValueError(f"{path}: target ids {odd} may hold only letters, digits, '.', '-', '_'")
     return targets
+
+
+@functools.cache
+def _paper_targets(slug: str) -> pd.DataFrame:
+    path = Path(__file__).resolve().parents[1] / "papers" / slug.replace("-", "_") / "targets.csv"
+    return load_targets(path).set_index("target_id")
+
+
+def paper_value(slug: str, target_id: str, unit: str | None = None) -> float:
+    """The value a paper prints for one of its targets (in `unit`, default the paper's): what a figure draws
+    beside the pipeline's curve, labelled "paper", read from targets.csv so that it is never retyped."""
+    row = _paper_targets(slug).loc[target_id]
+    value = float(row["value"])
+    return convert(value, row["unit"], unit) if unit is not None else value
 
 
 def deviation(pipeline: float, paper: float, tol: Tolerance) -> float:
@@ -129,7 +176,7 @@ def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
     report's run list: experiment, run_id, status) tells which experiments ran, and lets a target whose run
     failed say why."""
     runs = pd.DataFrame(columns=["experiment", "run_id", "status"]) if runs is None else runs
-    ran = set(runs["experiment"]) | set(metrics)
+    made = {(r.experiment, r.run_id) for r in runs.itertuples()}
     failed = {(r.experiment, r.run_id): r.status for r in runs.itertuples() if r.status != "ok"}
     rows = []
     for t in targets.itertuples(index=False):
@@ -140,19 +187,24 @@ def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
                "basis": t.basis, "tolerance": str(tol), "status": "not-reproducible", "cause": "", "note": t.note,
                "experiment": t.experiment, "run": t.run}
         if t.mode == "not reproducible":
-            row["cause"] = t.cause or "hardware-only"
-        elif t.experiment not in ran:
-            row["status"] = "not run"
+            row["cause"] = t.cause   # as declared: the hardware, a missing parameter, ...
         else:
             table = metrics.get(t.experiment)
-            found = pd.DataFrame()
-            if table is not None:
-                found = table[(table["metric"] == t.metric) & (table["run_id"] == t.run)]
-            if found.empty:
+            of_run = pd.DataFrame() if table is None else table[table["run_id"] == t.run]
+            found = of_run[of_run["metric"] == t.metric] if not of_run.empty else of_run
+            failed_here = {r: s for (e, r), s in failed.items() if e == t.experiment}
+            # neither a recorded run nor an aggregate of that id, and nothing failed: e.g. only a sweep of the
+            # experiment is on disk
+            if of_run.empty and (t.experiment, t.run) not in made and not failed_here:
+                row["status"] = "not run"
+            elif found.empty:
                 row["status"] = "miss"
                 why = failed.get((t.experiment, t.run))
-                why = f"run {t.experiment}/{t.run} {why}" if why else \
-                    f"no pipeline value ({t.experiment}/{t.run}: {t.metric})"
+                if why:
+                    why = f"run {t.experiment}/{t.run} {why}"
+                else:
+                    why = f"no pipeline value ({t.experiment}/{t.run}: {t.metric})" + "".join(
+                        f"; run {t.experiment}/{r} {s}" for r, s in failed_here.items())
                 row["note"] = "; ".join(x for x in (t.note, why) if x)
             else:
                 value = convert(float(found["value"].iloc[0]), found["unit"].iloc[0], t.unit)
@@ -162,7 +214,9 @@ def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
                 row["relative_deviation"] = row["deviation"] / abs(paper) if paper else float("nan")
                 row["status"] = judge(value, paper, t.op, tol)
             if t.mode == "consistency":
-                row["status"] = SELF_CHECK[row["status"]]
+                row["status"] = SELF_CHECK.get(row["status"], row["status"])
+                if row["status"] == "disagrees":
+                    row["cause"] = t.cause or "paper-inconsistent"
             elif row["status"] in ("miss", "close"):
                 row["cause"] = t.cause or "open"
         rows.append(row)

@@ -163,6 +163,22 @@ def available_experiments() -> list[str]:
     return sorted(str(p.relative_to(root).with_suffix("")) for p in root.glob("*/*.yaml"))
 
 
+def experiment_descriptions() -> dict[str, str]:
+    """`<slug>/<name>` -> the one-line `description:` of its config file (what `--help` lists)."""
+    import yaml
+
+    root = CONF_DIR / "experiment"
+    return {name: (yaml.safe_load((root / f"{name}.yaml").read_text()) or {}).get("description", "(no description)")
+            for name in available_experiments()}
+
+
+def experiment_list() -> str:
+    """Every experiment with its description, one per line (for the CLIs' --help)."""
+    described = experiment_descriptions()
+    width = max(map(len, described), default=0)
+    return "\n".join(f"  {name:<{width}}  {text}" for name, text in described.items())
+
+
 def resolve(experiment_id: str) -> Experiment:
     """`<slug>/<name>` -> the experiment function and everything declared to check its config."""
     slug, _, name = experiment_id.partition("/")

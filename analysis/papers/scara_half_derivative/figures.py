@@ -1,0 +1,144 @@
+"""`scara-half-derivative`: the figures (PNG + SVG under data/figures/<slug>/<experiment>/, declared in paper.yaml)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+from matplotlib import ticker
+
+from analysis.core.figures import Figures, plt
+from analysis.core.targets import paper_value
+from analysis.papers.scara_half_derivative.metrics import (
+    AXES,
+    CONTROLLER_COLORS,
+    FULL_PLOT_STRIDE,
+    KD_DAMPING,
+    SLUG,
+    ZOOM,
+    _stiffness_id,
+)
+from pipeline.core.runlog import Run
+
+
+def _setpoint_figures(ref: pd.DataFrame, joints: pd.DataFrame, figures: Figures) -> None:
+    t = ref.index.to_numpy()
+    fig, axes = plt.subplots(3, 1, figsize=(8, 6.5), sharex=True)
+    for ax, (field, label) in zip(axes, (("position", "position [m]"), ("velocity", "velocity [m/s]"),
+                                          ("acceleration", "acceleration [m/s²]")), strict=True):
+        for axis in AXES:
+            ax.plot(t, ref[f"{field}.{axis}"], lw=1, label=axis)
+        ax.set_ylabel(label)
+    axes[0].legend(ncol=3)
+    axes[-1].set_xlabel("time [s]")
+    fig.suptitle("Fig. 4: set-point of the end-effector (d = 0.15 m, t_mov = 0.3 s, t_stop = 1 s, α = 0.2)")
+    figures.save(fig, "fig4-setpoint")
+    fig, ax = plt.subplots(figsize=(8, 3.5))
+    for i in range(1, 5):
+        ax.plot(joints.index, np.rad2deg(joints[f"position.theta{i}"]), lw=1.2, label=f"θ{i}")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("joint position [°]")
+    ax.legend(ncol=4)
+    ax.set_title("Fig. 5: internal coordinates of the set-point motion (inverse kinematics)")
+    figures.save(fig, "fig5-joints")
+
+
+def _error_figures(k: float, controllers: dict[str, tuple[Run, dict]], figures: Figures) -> None:
+    """Figs. 8-10: e_x, e_y, e_z of the three controllers, the whole run and a zoom on the largest peak."""
+    for fig_number, axis in zip((8, 9, 10), AXES, strict=True):
+        fig, (full, zoom) = plt.subplots(1, 2, figsize=(10, 3.4), gridspec_kw={"width_ratios": [2.2, 1]})
+        errors = {name: controllers[name][0]["/tracking_error"][f"error.{axis}"] * 1e3
+                  for name in ("kd", "kdhd", "khd") if name in controllers}
+        if not errors:
+            plt.close(fig)
+            continue
+        peak = float(next(iter(errors.values())).abs().idxmax())   # KD's largest error, or the first run's
+        for name, err in errors.items():
+            full.plot(err.index[::FULL_PLOT_STRIDE], err.to_numpy()[::FULL_PLOT_STRIDE], lw=0.9,
+                      color=CONTROLLER_COLORS[name], label=name.upper())
+            window = err.loc[peak - ZOOM[0]:peak + ZOOM[1]]
+            zoom.plot(window.index, window, lw=1.1, color=CONTROLLER_COLORS[name])
+            printed = paper_value(SLUG, f"T2.e{axis}_max.{name}.k8e5")   # Table 2's max |e|, at ± on the plot
+            for ax in (full, zoom):
+                for sign in (1, -1):
+                    ax.axhline(sign * printed, color=CONTROLLER_COLORS[name], ls="--", lw=0.8, alpha=0.8)
+        full.plot([], [], "k--", lw=0.8, label="paper: max |e| (Table 2)")
+        full.set_xlabel("time [s]")
+        zoom.set_xlabel("time [s] (peak zone)")
+        full.set_ylabel(f"e_{axis} [mm]")
+        full.legend(ncol=3, loc="center", bbox_to_anchor=(0.5, 0.75))   # between the traces and the paper lines
+        fig.suptitle(f"Fig. {fig_number}: error e_{axis}, K = {k:g} N/m")
+        figures.save(fig, f"fig{fig_number}-e{axis}-{_stiffness_id(k)}")
+
+
+def _map_figure(k: float, grid: pd.DataFrame, level: float, points: list, figures: Figures) -> None:
+    """Fig. 6 as surfaces (red, with the KD level as a green plane) and as contour maps with the equal-ICE
+    points, our fitted line and eq. (20)."""
+    ice = grid.pivot(index="hd_xyz", columns="d_xyz", values="ice")
+    ise = grid.pivot(index="hd_xyz", columns="d_xyz", values="ise")
+    if min(ice.shape) < 2:   # a single line of the grid: curves instead of surfaces
+        fig, axes = plt.subplots(1, 2, figsize=(10, 3.4))
+        for ax, table, label in zip(axes, (ice, ise), ("ICE [N²m²s]", "ISE [m²s]"), strict=True):
+            for hd, row in table.iterrows():
+                ax.plot(row.index, row.to_numpy(), "o-", label=f"hd_xyz = {hd:g}")
+            ax.set_xlabel("d_xyz [Ns/m]")
+            ax.set_ylabel(label)
+        axes[0].legend()
+        fig.suptitle(f"Fig. 6 (one grid line on disk), K = {k:g} N/m")
+        figures.save(fig, f"fig6-maps-{_stiffness_id(k)}")
+        return
+    D, HD = np.meshgrid(ice.columns.to_numpy(), ice.index.to_numpy())
+    fig = plt.figure(figsize=(11, 8))
+    kd_ise = grid[(grid["hd_xyz"] == 0) & np.isclose(grid["d_xyz"], KD_DAMPING)]["ise"]
+    for col, (table, label, plane) in enumerate(
+            ((ice, "ICE [N²m²s]", level), (ise, "ISE [m²s]", kd_ise.iloc[0] if len(kd_ise) else np.nan))):
+        ax = fig.add_subplot(2, 2, col + 1, projection="3d")
+        ax.plot_surface(D, HD, table.to_numpy(), color="tab:red", alpha=0.75, edgecolor="k", lw=0.3)
+        if np.isfinite(plane):
+            ax.plot_surface(D, HD, np.full(D.shape, plane), color="tab:green", alpha=0.25)
+        ax.set_xlabel("d_xyz [Ns/m]")
+        ax.set_ylabel("hd_xyz [Ns^½/m]")
+        ax.set_zlabel(label)
+        flat = fig.add_subplot(2, 2, col + 3)
+        values = table.to_numpy()
+        wide = np.nanmax(values) > 10 * np.nanmin(values)   # near-unstable corners: a log scale keeps the rest
+        filled = flat.contourf(D, HD, values, levels=12, cmap="viridis",
+                               locator=ticker.LogLocator(subs="all") if wide else None)
+        fig.colorbar(filled, ax=flat, label=label)
+        if np.isfinite(plane):
+            flat.contour(D, HD, table.to_numpy(), levels=[plane], colors="w", linewidths=1.5)
+        d_line = np.linspace(D.min(), D.max(), 50)
+        flat.plot(d_line, 47200 - 9.44 * d_line, "y:", lw=2, label="eq. (20)")
+        if len(points) >= 2:
+            d, hd = np.array(points).T
+            slope, intercept = np.polyfit(d, hd, 1)
+            flat.plot(d, hd, "wo", ms=4)
+            flat.plot(d_line, intercept + slope * d_line, "w--", lw=1, label="fitted equal-ICE line")
+        flat.set_ylim(HD.min(), HD.max())
+        flat.set_xlabel("d_xyz [Ns/m]")
+        flat.set_ylabel("hd_xyz [Ns^½/m]")
+        flat.legend(loc="upper right", fontsize=7)
+    fig.suptitle(f"Fig. 6: ICE (left) and ISE (right) over the grid on disk, K = {k:g} N/m "
+                 "(green: KD at d = 5000; white: its level)")
+    figures.save(fig, f"fig6-maps-{_stiffness_id(k)}")
+
+
+def _path_figure(k: float, path: pd.DataFrame, ratio: pd.DataFrame, figures: Figures) -> None:
+    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 3.6))
+    d = path["d_xyz"].to_numpy()
+    left.plot(d, path["ise"], "o-", color="C0", label="ISE")
+    left.set_xlabel("d_xyz [Ns/m]")
+    left.set_ylabel("ISE [m²s]", color="C0")
+    left.invert_xaxis()
+    twin = left.twinx()
+    twin.plot(d, path["hd_xyz"], "s-", color="C1", label="hd_xyz")
+    twin.set_ylabel("hd_xyz [Ns^½/m]", color="C1")
+    twin.spines["right"].set_visible(True)
+    for i in range(1, 4):
+        right.plot(d, 100 * ratio[f"tau{i}.max"], "o-", label=f"τ{i}")
+    right.plot(d, 100 * ratio["ice"], "k--", lw=1, label="ICE")
+    right.set_xlabel("d_xyz [Ns/m]")
+    right.set_ylabel("% of KD (d = 5000)")
+    right.invert_xaxis()
+    right.legend(ncol=2)
+    fig.suptitle(f"Fig. 7: along eq. (20), KD (d = 5000) to KHD (d = 0), K = {k:g} N/m")
+    figures.save(fig, f"fig7-path-{_stiffness_id(k)}")

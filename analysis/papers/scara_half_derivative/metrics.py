@@ -1,0 +1,169 @@
+"""`scara-half-derivative`: constants, what is read from a run, and the metrics computed from it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import yaml
+
+from analysis.core.errors import error_stats
+from analysis.core.metrics import MetricTable
+from analysis.core.targets import paper_value
+from pipeline.core.runlog import Run
+
+AXES = ("x", "y", "z")
+
+
+JOINT_TORQUES = [f"value.theta{i}" for i in range(1, 5)]
+
+
+NOISE = 1e-9                 # SI: a reference value this small is round-off (τ4 ≡ 0 in the model)
+
+
+KD_DAMPING = 5000.0          # N s/m: the reference KD of every comparison (Sec. 5)
+
+
+LEVEL_TOLERANCE = 1e-9       # relative: grid values this close count as equal
+
+
+TABLE2 = ["e.x.max", "e.y.max", "e.z.max", "e.x.mean", "e.y.mean", "e.z.mean", "tau1.max", "tau2.max",
+          "tau3.max", "tau4.max", "ise"]
+
+
+CONTROLLER_COLORS = {"kd": "C0", "kdhd": "C3", "khd": "C2"}
+
+
+FULL_PLOT_STRIDE = 5       # samples drawn in the whole-run panels (the zoom draws every sample)
+
+
+ZOOM = (0.08, 0.25)        # s before and after the peak in the zoom panels
+
+
+SWING = 5e-6                 # m: an error reversal this large counts as one swing of an oscillation
+
+
+def _model(run: Run) -> dict:
+    return yaml.safe_load(run.attachments["model.yaml"])
+
+
+def _tuning(run: Run) -> dict[str, float]:
+    g = _model(run)["gains"]
+    return {"k_xyz": g["k_xyz"], "d_xyz": g["d_xyz"], "hd_xyz": g["hd_xyz"]}
+
+
+def _stiffness_id(k: float) -> str:
+    return f"k{k:g}"
+
+
+def tuning_metrics(run: Run) -> dict[str, tuple[float, str]]:
+    """Table 2's indexes, ICE and the Exudyn loop gap of one closed-loop run."""
+    err = run["/tracking_error"]
+    t = err.index.to_numpy()
+    values: dict[str, tuple[float, str]] = {}
+    ise = 0.0
+    for axis in AXES:
+        stats = error_stats(t, err[f"error.{axis}"].to_numpy(), f"e.{axis}", "m")
+        values |= {k: stats[k] for k in (f"e.{axis}.max", f"e.{axis}.mean")}
+        ise += stats[f"e.{axis}.ise"][0]
+    values["ise"] = (ise, "m^2*s")   # eq. (19)
+    command = run["/command"]
+    tau = command[JOINT_TORQUES].to_numpy()
+    period = float(np.diff(command.index.to_numpy()).mean())
+    values["ice"] = (float((tau ** 2).sum() * period), "N^2*m^2*s")   # eq. (18), torques held over each period
+    for i in range(4):
+        values[f"tau{i + 1}.max"] = (float(np.abs(tau[:, i]).max()), "Nm")
+    if "/loop_closure" in run.topic_names:
+        values["loop_gap.max"] = (float(run["/loop_closure"]["value.gap"].abs().max()), "m")
+    return values
+
+
+def _percentages(m: MetricTable, reference: dict, variant: dict, run_id: str, params: dict, names) -> None:
+    for name in names:
+        base = reference[name][0]
+        if abs(base) > NOISE:   # τ4 is zero up to round-off: no percentage of noise
+            m.add(run_id, f"pct.{name}", variant[name][0] / base - 1.0, "fraction", params)
+
+
+def _config_node(run: Run):
+    from omegaconf import OmegaConf
+
+    return OmegaConf.create(run.config["system"])
+
+
+def _reversals(e: np.ndarray, amplitude: float) -> int:
+    """How often the signal turns back by at least `amplitude` (a swing counter with hysteresis, blind to
+    numerical ripple)."""
+    count, extreme, direction = 0, e[0], 0
+    for value in e.tolist():
+        if direction >= 0 and value < extreme - amplitude:
+            count += direction == 1
+            direction, extreme = -1, value
+        elif direction <= 0 and value > extreme + amplitude:
+            count += direction == -1
+            direction, extreme = 1, value
+        elif (direction == 1 and value > extreme) or (direction == -1 and value < extreme):
+            extreme = value
+    return count
+
+
+def _ringing(run: Run) -> int:
+    """Swings of e_x, e_y, e_z larger than SWING over the run: the oscillation that Figs. 8-10 show."""
+    err = run["/tracking_error"]
+    return sum(_reversals(err[f"error.{axis}"].to_numpy(), SWING) for axis in AXES)
+
+
+def grid_frame(runs: list[Run]) -> pd.DataFrame:
+    """One row per grid point on disk (k_xyz, d_xyz, hd_xyz, run_id, ISE, ICE, peak torques); a point run
+    twice (the sweep and the default run) is kept once."""
+    rows = [{**_tuning(run), "run_id": run.run_id, **{k: v for k, (v, _) in tuning_metrics(run).items()}}
+            for run in runs]
+    if not rows:
+        return pd.DataFrame(columns=["k_xyz", "d_xyz", "hd_xyz", "run_id", "ise", "ice"])
+    frame = pd.DataFrame(rows).sort_values(["k_xyz", "d_xyz", "hd_xyz", "run_id"])
+    return frame.drop_duplicates(["k_xyz", "d_xyz", "hd_xyz"]).reset_index(drop=True)
+
+
+def equal_ice_locus(grid: pd.DataFrame) -> tuple[float, list[tuple[float, float]]]:
+    """(ICE of KD at d = 5000, points (d, hd) where ICE equals it): for each hd of the grid, the d at which
+    ICE crosses the level, by linear interpolation along d (the KD point itself included)."""
+    kd = grid[(grid["hd_xyz"] == 0) & np.isclose(grid["d_xyz"], KD_DAMPING, rtol=LEVEL_TOLERANCE)]
+    if kd.empty:
+        return float("nan"), []
+    level = float(kd["ice"].iloc[0])
+    points = []
+    for hd, column in grid.groupby("hd_xyz"):
+        column = column.sort_values("d_xyz")
+        d, ice = column["d_xyz"].to_numpy(), column["ice"].to_numpy() - level
+        for i in range(len(d) - 1):
+            if ice[i] == 0:
+                points.append((float(d[i]), float(hd)))
+            elif ice[i] * ice[i + 1] < 0:
+                points.append((float(d[i] - ice[i] * (d[i + 1] - d[i]) / (ice[i + 1] - ice[i])), float(hd)))
+        if len(d) and ice[-1] == 0:
+            points.append((float(d[-1]), float(hd)))
+    return level, sorted(set(points))
+
+
+def _monotonic(grid: pd.DataFrame, metric: str, sign: int) -> bool:
+    """`metric` changes with the sign `sign` along every grid line of d and of hd."""
+    table = grid.pivot(index="d_xyz", columns="hd_xyz", values=metric)
+    steps = [np.diff(table.to_numpy(), axis=0), np.diff(table.to_numpy(), axis=1)]
+    finite = [s[np.isfinite(s)] for s in steps]
+    return bool(all((sign * s > 0).all() for s in finite) and any(s.size for s in finite))
+
+
+SLUG = "scara-half-derivative"
+TABLE2_ROWS = ("e.x.max", "e.y.max", "e.z.max", "e.x.mean", "e.y.mean", "e.z.mean", "tau1.max", "tau2.max",
+               "tau3.max", "tau4.max", "ise")
+
+
+def paper_table2() -> dict[str, tuple[float, float, float]]:
+    """Table 2 as printed, read from targets.csv: metric -> (KD, KDHD, KHD) in mm, Nm, m²s."""
+    def target(metric: str, controller: str) -> str:
+        name = metric.replace("e.", "e").replace(".", "_") if metric != "ise" else "ise"
+        return f"T2.{name}.{controller}.k8e5"
+
+    return {m: tuple(paper_value(SLUG, target(m, c)) for c in ("kd", "kdhd", "khd")) for m in TABLE2_ROWS}
+
+
+SCALE = {"e": 1e3}   # m -> mm for the error rows
