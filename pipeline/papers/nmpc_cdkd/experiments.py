@@ -99,7 +99,8 @@ def log_trajectory(log: RunWriter, arm: Arm, tr: Trajectory, model: str, obstacl
                    names: list[str], offset: float = 0.0) -> None:
     """Write one closed-loop move; `offset` (s) places it after earlier moves of the same run."""
     t = tr.t + offset
-    log.log_series("/joint_state", t, name=JOINTS, position=tr.q, velocity=tr.qd, effort=tr.effort)
+    efforts = {"effort": tr.effort} if np.isfinite(tr.effort).all() else {}  # a kinematic plant has none
+    log.log_series("/joint_state", t, name=JOINTS, position=tr.q, velocity=tr.qd, **efforts)
     log.log_series("/command", t, kind="position", name=JOINTS, value=tr.q_cmd)
     log.log_series("/command/velocity", t, kind="velocity", name=JOINTS, value=tr.qd_cmd)
     log.log_series("/reference", t, name=JOINTS, position=tr.q_ref, velocity=tr.qd_ref)
