@@ -8,7 +8,7 @@ import dataclasses
 import time
 
 import numpy as np
-from omegaconf import DictConfig
+from omegaconf import DictConfig, OmegaConf
 
 from pipeline.core import markers, schemas
 from pipeline.core.experiment import Case
@@ -61,14 +61,14 @@ def geometry(cfg: DictConfig) -> Geometry:
 
 
 def humans(cfg: DictConfig) -> HumanArms:
-    h = cfg.system.humans
+    h = OmegaConf.to_container(cfg.system.humans)
     arrays = {k: np.asarray(h[k], dtype=float) for k in ("base", "base_radius", "base_turns", "shoulder_range",
                                                          "shoulder_offset", "shoulder_turns", "elbow_range",
                                                          "elbow_offset", "elbow_turns", "radius")}
     if arrays["base"].ndim != 2 or arrays["base"].shape[1] != 3 or len(arrays["radius"]) != 2:
         raise ValueError("system.humans.base needs one [x, y, z] per arm and system.humans.radius two radii")
-    return HumanArms(**arrays, upper_length=h.upper_length, fore_length=h.fore_length, plane=h.plane,
-                     range_is=h.range_is)
+    return HumanArms(**arrays, upper_length=h["upper_length"], fore_length=h["fore_length"], plane=h["plane"],
+                     range_is=h["range_is"])
 
 
 def settings(cfg: DictConfig, case: str = "avoid") -> planner.Settings:
@@ -258,7 +258,7 @@ def replay(log: RunWriter, cfg: DictConfig, times: np.ndarray, plan: planner.Pla
     q_ref, qd_ref = spline(t), spline(t, 1)
     xml = replay_model(cfg, arms, q_ref[0])
     log.attach("model.xml", xml, "application/xml")
-    states, sensors = servo_rollout(xml, q_ref, qd_ref, t)
+    states, sensors = servo_rollout(xml, q_ref, qd_ref, t, moving_start=True)   # a replay joins the motion
     every = max(1, round(rp.log_dt / rp.dt))
     t_state = (t + rp.dt)[::every]                    # rollout returns the state after each step
     q, qd, tau = states[::every, 1:8], states[::every, 8:15], sensors[::every, :7]
@@ -291,32 +291,24 @@ def replay(log: RunWriter, cfg: DictConfig, times: np.ndarray, plan: planner.Pla
                    distance_m=executed.reshape(len(times), -1))
 
 
-def log_planned_state(log: RunWriter, cfg: DictConfig, times: np.ndarray, plan: planner.Plan,
-                      capsules: tuple, arms: HumanArms) -> None:
-    """Without a replay, the planned motion is the joint state (velocities by central differences)."""
-    log.log_series("/joint_state", times, name=JOINTS, position=plan.q, velocity=np.gradient(plan.q, times, axis=0))
-    start, end, _ = capsules
-    log_frames(log, times, plan.q, geometry(cfg), plan.poses, start, end, arms)
-
-
-# -- experiments --------------------------------------------------------------------------------------------------
-
-
-def _simulate(log: RunWriter, cfg: DictConfig, case: str, with_replay: bool) -> None:
+def _simulate(log: RunWriter, cfg: DictConfig, case: str, replayed: bool) -> None:
+    """One case: Algorithm 1 over the task, logged; then either the MuJoCo replay (the arm drawn as it moved)
+    or, for the ablation's many runs, the planned joints alone (no scene)."""
     times, plan, points, capsules = plan_case(cfg, case)
     arms = humans(cfg)
-    log_scene(log, cfg, arms, geometry(cfg))
-    log_collision_points(log, times, plan, cfg.system.filter.dt)
     log_plan(log, cfg, times, plan, points, capsules, arms)
     log.log_series("/reference/tool", times, schemas.Reference, name=XYZ, position=plan.poses[:, :3, 3])
-    if with_replay:
+    if replayed:
+        log_scene(log, cfg, arms, geometry(cfg))
+        log_collision_points(log, times, plan, cfg.system.filter.dt)
         replay(log, cfg, times, plan, capsules, arms)
     else:
-        log_planned_state(log, cfg, times, plan, capsules, arms)
+        log.log_series("/joint_state", times, name=JOINTS, position=plan.q,
+                       velocity=np.gradient(plan.q, times, axis=0))
 
 
 def circle(cfg: DictConfig) -> list[Case]:
-    return [Case(case, lambda log, c=case: _simulate(log, cfg, c, cfg.replay.enabled)) for case in cfg.scenario.cases]
+    return [Case(case, lambda log, c=case: _simulate(log, cfg, c, True)) for case in cfg.scenario.cases]
 
 
 def ablation(cfg: DictConfig) -> list[Case]:
