@@ -21,6 +21,7 @@ from pipeline.papers.srs_collision_avoidance.kinematics import JOINTS, Geometry,
 from pipeline.robotics.transforms import rotation_angle
 
 LINK_FRAMES = [*(f"link{i}" for i in range(1, 8)), "tool"]
+WORLD_BASE = pose(mujoco_replay.R_WORLD_BASE, np.zeros(3))   # the paper's y-up base in the z-up world
 XYZ = ["x", "y", "z"]
 # what each case of `scenario.cases` changes in the configured algorithm
 VARIANTS = {
@@ -148,9 +149,7 @@ def log_scene(log: RunWriter, cfg: DictConfig, arms: HumanArms, g: Geometry) -> 
     entities += [markers.capsule(frame, frame, [0, 0, 0], [0, 0, length], radius, skin)
                  for frame, length, radius in zip(human_frame_names(arms), lengths, radii, strict=True)]
     log.write("/markers", 0, schemas.SceneUpdate(entities=entities))
-    world = np.eye(4)
-    world[:3, :3] = mujoco_replay.R_WORLD_BASE
-    log.log_transforms(np.zeros(1), "world", ["base"], world[None, None])
+    log.log_transforms(np.zeros(1), "world", ["base"], WORLD_BASE[None, None])
 
 
 def _ball(name: str, position, radius: float, color, lifetime_ns: int) -> schemas.SceneEntity:
@@ -216,8 +215,9 @@ def pair_names(arms: HumanArms) -> list[str]:
 
 def log_frames(log: RunWriter, times: np.ndarray, q: np.ndarray, g: Geometry, targets: np.ndarray,
                start: np.ndarray, end: np.ndarray, arms: HumanArms) -> None:
+    """Link, target and human frames in `world` (z up; every viewer then agrees, whatever it makes of parents)."""
     frames = np.concatenate([link_frames(q, g), targets[:, None], _frames_along(start, end)], axis=1)
-    log.log_transforms(times, "base", [*LINK_FRAMES, "target", *human_frame_names(arms)], frames)
+    log.log_transforms(times, "world", [*LINK_FRAMES, "target", *human_frame_names(arms)], WORLD_BASE @ frames)
 
 
 # -- the MuJoCo replay ----------------------------------------------------------------------------------------
