@@ -54,7 +54,7 @@ def fig08_09_swivel_rates(s: Signals, figures: Figures) -> None:
 def fig10_11_joints(by_case: dict[str, Signals], figures: Figures) -> None:
     s, task = by_case["avoid"], by_case.get("no-avoid")
     for joints, name in ((range(0, 3), "fig10-joints-1-3"), (range(3, 7), "fig11-joints-4-7")):
-        fig, ax = plt.subplots(figsize=(8, 3.6))
+        fig, ax = plt.subplots(figsize=(8.8, 3.6))
         for j in joints:
             ax.plot(_iterations(s), s.q[:, j], color=f"C{j}", lw=1.4, label=f"θ{j + 1}")
             if task is not None:
@@ -64,7 +64,7 @@ def fig10_11_joints(by_case: dict[str, Signals], figures: Figures) -> None:
         first = joints[0] + 1
         ax.set_title(f"Fig. {10 if first == 1 else 11}: IK joints {first}-{joints[-1] + 1} with avoidance "
                      "(dotted: the task alone)")
-        ax.legend(ncol=4, loc="upper right")
+        ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0))
         figures.save(fig, name)
 
 

@@ -5,7 +5,6 @@ the per-iteration compute time of Algorithm 1 (`compute-time`)."""
 from __future__ import annotations
 
 import dataclasses
-import time
 
 import numpy as np
 from omegaconf import DictConfig, OmegaConf
@@ -13,11 +12,11 @@ from omegaconf import DictConfig, OmegaConf
 from pipeline.core import markers, schemas
 from pipeline.core.experiment import Case
 from pipeline.core.runlog import RunWriter, SimulationFailed
-from pipeline.core.timing import time_calls
+from pipeline.core.timing import log_timings, time_calls
 from pipeline.papers.srs_collision_avoidance import clearance, mujoco_replay, planner, swivel_filter
 from pipeline.papers.srs_collision_avoidance.avoidance import CASES, Forms, SafetyVolume
 from pipeline.papers.srs_collision_avoidance.humans import HumanArms
-from pipeline.papers.srs_collision_avoidance.kinematics import JOINTS, Geometry, Unreachable, fk, link_frames, pose
+from pipeline.papers.srs_collision_avoidance.kinematics import JOINTS, Geometry, Unreachable, fk, ik, link_frames, pose
 from pipeline.robotics.transforms import rotation_angle
 
 LINK_FRAMES = [*(f"link{i}" for i in range(1, 8)), "tool"]
@@ -176,8 +175,8 @@ def log_collision_points(log: RunWriter, times: np.ndarray, plan: planner.Plan, 
 
 def log_plan(log: RunWriter, cfg: DictConfig, times: np.ndarray, plan: planner.Plan, points: np.ndarray,
              capsules: tuple, arms: HumanArms) -> None:
-    """What Algorithm 1 computed, every sample: swivel signals, the collision test, clearances, the IK's tool
-    error, and the planned frames (the executed ones come from the replay when there is one)."""
+    """What Algorithm 1 computed, every sample: swivel signals, the collision test, the human points, clearances
+    (safety volume and bodies), the IK's tool error, and the joints at α_f and at α = 0."""
     s, g, dt = cfg.system, geometry(cfg), cfg.system.filter.dt
     rate = np.r_[0.0, np.diff(plan.alpha_f)] / dt                               # Fig. 8: first difference / T
     acceleration = np.r_[0.0, np.diff(rate)] / dt                               # Fig. 9
@@ -308,43 +307,38 @@ def _simulate(log: RunWriter, cfg: DictConfig, case: str, replayed: bool) -> Non
 
 
 def circle(cfg: DictConfig) -> list[Case]:
+    humans(cfg)   # shapes checked before anything runs
     return [Case(case, lambda log, c=case: _simulate(log, cfg, c, True)) for case in cfg.scenario.cases]
 
 
 def ablation(cfg: DictConfig) -> list[Case]:
+    humans(cfg)
     return [Case(case, lambda log, c=case: _simulate(log, cfg, c, False)) for case in cfg.scenario.cases]
 
 
 def compute_time(cfg: DictConfig) -> list[Case]:
     """Algorithm 1 one iteration at a time (`planner.Online`), every iteration timed, `scenario.repeats` passes
-    over the task after `scenario.warmup` untimed iterations; the whole-run batch form timed beside it; and the
-    online joints checked against the batch plan."""
+    over the task after `scenario.warmup` untimed iterations; the IK alone and the whole-run batch form timed
+    beside it; and the online joints checked against the batch plan."""
     sc = cfg.scenario
+    humans(cfg)   # shapes checked before anything runs
 
     def simulate(log: RunWriter) -> None:
         _, poses = task(cfg)
         _, start, end, radius = obstacles(cfg, humans(cfg))
         s = settings(cfg, "avoid")
         batch = planner.plan(poses, start, end, radius, s)
+        inputs = [(T, a, b, radius) for T, a, b in zip(poses, start, end, strict=True)]
         online = planner.Online(s)
-        q = np.array([online.step(T, a, b, radius) for T, a, b in zip(poses, start, end, strict=True)])
+        q = np.array([online.step(*args) for args in inputs])
         gap = np.abs(np.angle(np.exp(1j * (q - batch.q)))).max()
         log.log("/online_vs_batch", 0.0, schemas.Scalars, name=["max_joint_difference_rad"], value=[float(gap)])
-        inputs = [(T, a, b, radius) for T, a, b in zip(poses, start, end, strict=True)]
-        timed = planner.Online(s)
-        per_iteration = time_calls("algorithm1", timed.step, inputs, warmup=sc.warmup, repeats=sc.repeats)
-        runs = []
-        for _ in range(sc.batch_repeats):
-            t0 = time.perf_counter()
-            planner.plan(poses, start, end, radius, s)
-            runs.append(time.perf_counter() - t0)
-        ik_only = time_calls("ik", lambda T: planner.ik(T, 0.3, s.geometry), [(T,) for T in poses], warmup=sc.warmup)
-        n = len(per_iteration.seconds)
-        log.log_series("/compute_time", np.arange(n) * 1e-3, name=["algorithm1"], calls=[1],
-                       seconds=per_iteration.seconds[:, None])
-        log.log_series("/compute_time", n * 1e-3 + np.arange(len(poses)) * 1e-3, name=["ik"], calls=[1],
-                       seconds=ik_only.seconds[:, None])
-        log.log_series("/compute_time", (n + len(poses)) * 1e-3 + np.arange(len(runs)) * 1e-3,
-                       name=["algorithm1_batch"], calls=[len(poses)], seconds=np.asarray(runs)[:, None])
+        timings = [
+            time_calls("algorithm1", planner.Online(s).step, inputs, warmup=sc.warmup, repeats=sc.repeats),
+            time_calls("ik", lambda T: ik(T, 0.3, s.geometry), [(T,) for T in poses], warmup=sc.warmup),
+            time_calls("algorithm1_batch", lambda: planner.plan(poses, start, end, radius, s), [()], warmup=1,
+                       repeats=sc.batch_repeats, items_per_call=len(poses)),
+        ]
+        log_timings(log, timings)
 
     return [Case("algorithm1", simulate)]
