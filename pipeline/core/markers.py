@@ -36,3 +36,41 @@ def height_field(name: str, x: np.ndarray, y: np.ndarray, z: np.ndarray, frame: 
     mesh = schemas.TriangleListPrimitive(pose=schemas.Pose(orientation=schemas.Quaternion(w=1.0)), points=points,
                                          color=_color(color), indices=triangles.ravel().tolist())
     return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True, triangles=[mesh])
+
+
+def _z_onto(direction: np.ndarray) -> schemas.Quaternion:
+    """The rotation taking +z onto `direction` (Foxglove cylinders stand along their local z)."""
+    d = np.asarray(direction, dtype=float) / np.linalg.norm(direction)
+    w, (x, y, z) = 1.0 + d[2], np.cross([0.0, 0.0, 1.0], d)
+    if w < 1e-12:  # pointing down: half a turn about x
+        return schemas.Quaternion(x=1.0, y=0.0, z=0.0, w=0.0)
+    n = np.sqrt(w * w + x * x + y * y + z * z)
+    return schemas.Quaternion(x=x / n, y=y / n, z=z / n, w=w / n)
+
+
+def _cylinder(start, end, radius_start: float, radius_end: float, color) -> schemas.CylinderPrimitive:
+    start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+    middle, widest = (start + end) / 2, max(radius_start, radius_end)
+    return schemas.CylinderPrimitive(
+        pose=schemas.Pose(position=schemas.Vector3(x=middle[0], y=middle[1], z=middle[2]),
+                          orientation=_z_onto(end - start)),
+        size=schemas.Vector3(x=2 * widest, y=2 * widest, z=float(np.linalg.norm(end - start))),
+        bottom_scale=radius_start / widest, top_scale=radius_end / widest, color=_color(color))
+
+
+def capsule(frame: str, name: str, start: Sequence[float], end: Sequence[float], radius: float,
+            color: Sequence[float]):
+    """A capsule (a cylinder with a sphere at each end) from `start` to `end` in /tf frame `frame`."""
+    caps = [schemas.SpherePrimitive(pose=schemas.Pose(position=schemas.Vector3(x=p[0], y=p[1], z=p[2]),
+                                                      orientation=schemas.Quaternion(w=1.0)),
+                                    size=schemas.Vector3(x=2 * radius, y=2 * radius, z=2 * radius), color=_color(color))
+            for p in (start, end)]
+    return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True,
+                               cylinders=[_cylinder(start, end, radius, radius, color)], spheres=caps)
+
+
+def cone(frame: str, name: str, start: Sequence[float], end: Sequence[float], radius_start: float,
+         radius_end: float, color: Sequence[float]):
+    """A truncated cone from `start` (radius_start) to `end` (radius_end) in /tf frame `frame`."""
+    return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True,
+                               cylinders=[_cylinder(start, end, radius_start, radius_end, color)])

@@ -117,6 +117,29 @@ def with_servo_gains(build: Callable[[np.ndarray, np.ndarray], str], q0: np.ndar
     return build(m * w * w, 2 * damping_ratio * m * w)
 
 
+def servo_rollout(xml: str, q_ref: np.ndarray, qd_ref: np.ndarray, times: np.ndarray, *, moving_start: bool = False
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """A whole servoed run in one C call: the model's actuators are the joint servo (controls [q_ref, q̇_ref],
+    as `serial_arm` builds them), started on q_ref[0], at rest or (`moving_start`) already at q̇_ref[0].
+    Returns (states, sensors), one row per step, each the state after the step (full physics state: time,
+    qpos, qvel, …)."""
+    import mujoco
+    from mujoco import rollout
+
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    data.qpos[:] = q_ref[0]
+    if moving_start:
+        data.qvel[:] = qd_ref[0]
+    mujoco.mj_forward(model, data)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    state0 = np.empty(mujoco.mj_stateSize(model, spec))
+    mujoco.mj_getState(model, data, state0, spec)
+    states, sensors = rollout.rollout(model, data, state0, np.concatenate([q_ref, qd_ref], axis=1)[None])
+    check_mujoco(data, states[0], times)
+    return states[0], sensors[0]
+
+
 # MuJoCo does not return NaN when a simulation blows up: it warns and resets the state. These warnings
 # therefore mark a run as failed.
 _UNSTABLE = ("mjWARN_BADQACC", "mjWARN_BADQVEL", "mjWARN_BADQPOS", "mjWARN_BADCTRL")
