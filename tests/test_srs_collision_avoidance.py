@@ -268,7 +268,8 @@ def test_unreachable_task_is_a_failed_run():
     "system.filter.p=-0.2", "system.filter.p=nan", "system.filter.dt=0", "system.task.samples=1000000000",
     "system.algorithm.d_m2=bogus", "system.algorithm.link_checks=elsif", "system.ik.wrist_sign=0",
     "scenario.cases=[avoid,foo]", "replay.dt=1e-9", "system.safety.d_cmax=-1", "system.humans.plane=yz",
-    "system.humans.base_turns=[5,1e9]", "system.task.rides=abc",
+    "system.humans.base_turns=[5,1e9]", "system.task.rides=abc", "system.humans.base=[[0.1,0.5]]",
+    "system.humans.radius=0.05", "system.safety.d_cmin=0.2",
 ])
 def test_bad_input_is_refused_in_one_line(override):
     with pytest.raises(BadInput) as err:

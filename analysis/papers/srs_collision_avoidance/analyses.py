@@ -8,8 +8,7 @@ import pandas as pd
 from analysis.core.figures import Figures
 from analysis.core.metrics import MetricTable
 from analysis.papers.srs_collision_avoidance import figures as fig
-from analysis.papers.srs_collision_avoidance.metrics import compute_time_metrics, ratio, run_metrics
-from analysis.papers.srs_collision_avoidance.signals import read
+from analysis.papers.srs_collision_avoidance.metrics import compute_time_metrics, ratio, read, run_metrics
 from pipeline.core.runlog import Run
 
 
@@ -66,3 +65,6 @@ def analyze_compute_time(runs: list[Run], figures: Figures) -> pd.DataFrame:
         ct = run["/compute_time"]
         fig.compute_time_histogram(np.asarray(ct["seconds.algorithm1"].dropna()), figures)
     return m.frame()
+
+
+ANALYSES = {"circle": analyze_circle, "ablation": analyze_ablation, "compute-time": analyze_compute_time}

@@ -7,6 +7,7 @@ import pandas as pd
 
 from analysis.core.compute_time import compute_time_section, machine_of
 from analysis.core.metrics import metric_value
+from analysis.core.sections import Section, Table
 
 CASES = ("no-avoid", "avoid", "avoid-unfiltered", "avoid-printed", "avoid-exact", "avoid-capsules")
 # metric, column title, scale from SI
@@ -23,34 +24,34 @@ COLUMNS = (("volume.intrusion_fraction", "inside safety volume [% samples]", 100
            ("replay.tool_error.max", "replay max tool error [mm]", 1e3))
 
 
-def _table(metrics: pd.DataFrame, runs: list[str], label: str) -> str:
+def _table(metrics: pd.DataFrame, runs: list[str], label: str) -> Table:
     rows = [{label: run, **{title: metric_value(metrics, run, metric) * scale for metric, title, scale in COLUMNS}}
             for run in runs]
-    return pd.DataFrame(rows).dropna(axis=1, how="all").to_markdown(index=False, floatfmt=".4g")
+    return Table(pd.DataFrame(rows).dropna(axis=1, how="all"))
 
 
-def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]:
+def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]:
     sections = []
     circle = metrics.get("circle")
     if circle is not None and not circle.empty:
         present = [c for c in CASES if c in set(circle["run_id"])]
         audit = max((metric_value(circle, c, "capsules.audit_max_difference") for c in present), default=float("nan"))
-        sections.append(
-            "## The circle task, every variant (Sec. 5)\n\n"
+        sections.append(Section(
+            "The circle task, every variant (Sec. 5)",
             "Margins are those of the six human points (shoulders, elbows, hands) outside the safety volume "
             "(cones on the links, the elbow sphere) at the executed posture; body clearance is between the human "
             "capsules and the arm's link capsules. `no-avoid` keeps α = 0 (the task alone); `avoid` is Algorithm 1 "
-            "with the text's forms and p = 0.2 s⁻¹; the others change one thing each.\n\n"
-            + _table(circle, present, "case")
-            + f"\n\nMuJoCo's `mj_geomDistance` on the same capsules agrees with ours to {audit:.2g} m (largest "
-              "difference over every sample, pair and case).")
+            "with the text's forms and p = 0.2 s⁻¹; the others change one thing each.",
+            _table(circle, present, "case"),
+            f"MuJoCo's `mj_geomDistance` on the same capsules agrees with ours to {audit:.2g} m (largest "
+            "difference over every sample, pair and case).", category="trajectories"))
     ablation = metrics.get("ablation")
     if ablation is not None and not ablation.empty:
         order = (ablation[["run_id", "system.algorithm.alpha_c", "system.filter.p"]].drop_duplicates()
                  .sort_values(["system.algorithm.alpha_c", "system.filter.p"]))
-        sections.append("## Ablation over the filter pole (our extension)\n\n"
-                        "p = 1000 s⁻¹ makes m = 60: eq. (3) then passes α_c one sample late, i.e. unfiltered.\n\n"
-                        + _table(ablation, order["run_id"].tolist(), "run"))
+        sections.append(Section("Ablation over the filter pole (our extension)",
+                                "p = 1000 s⁻¹ makes m = 60: eq. (3) then passes α_c one sample late, i.e. unfiltered.",
+                                _table(ablation, order["run_id"].tolist(), "run"), category="trajectories"))
     ct = metrics.get("compute-time")
     if ct is not None and not ct.empty:
         total = metric_value(ct, "algorithm1", "algorithm1.run_total")
