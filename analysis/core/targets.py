@@ -29,7 +29,8 @@ Statuses of a reproduction (modes exact, relative, bound, qualitative):
   miss        farther off, or no pipeline value although the experiment ran (a failed run says why)
   not run     the target's experiment has no runs in this data_dir
 Statuses of a `consistency` row: agrees / disagrees (the same rule as match / miss), or not run.
-A `not reproducible` row (hardware only) has status not-reproducible.
+A `not reproducible` row (hardware only) has status not-reproducible; if it names the experiment, run and metric of
+its closest simulated stand-in, that value is shown as its pipeline value, beside the paper's, and not judged.
 """
 
 from __future__ import annotations
@@ -121,6 +122,14 @@ def judge(pipeline: float, paper: float, op: str, tol: Tolerance) -> str:
 SELF_CHECK = {"match": "agrees", "close": "disagrees", "miss": "disagrees"}
 
 
+def _stand_in(table: pd.DataFrame | None, t) -> float | None:
+    """The value a `not reproducible` row names as its simulated stand-in, in the row's unit (None if absent)."""
+    if table is None:
+        return None
+    found = table[(table["metric"] == t.metric) & (table["run_id"] == t.run)]
+    return None if found.empty else convert(float(found["value"].iloc[0]), found["unit"].iloc[0], t.unit)
+
+
 def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
              runs: pd.DataFrame | None = None) -> pd.DataFrame:
     """One row per target with the pipeline's value (in the paper's unit), its deviation and a status.
@@ -141,6 +150,9 @@ def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
                "experiment": t.experiment, "run": t.run}
         if t.mode == "not reproducible":
             row["cause"] = t.cause or "hardware-only"
+            stand_in = _stand_in(metrics.get(t.experiment), t) if t.metric else None
+            if stand_in is not None:  # shown beside the paper's value, never judged
+                row["pipeline_value"] = stand_in
         elif t.experiment not in ran:
             row["status"] = "not run"
         else:
