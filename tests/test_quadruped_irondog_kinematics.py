@@ -117,7 +117,6 @@ def test_body_ik_moves_the_trunk_over_fixed_feet():
     # the feet, seen from the moved trunk, are where they were in the stance frame
     R = kin.rpy_matrix(rpy)
     assert np.abs(kin.feet_in_body(LEG, LAYOUT, q) @ R.T + position - feet).max() < 1e-12
-    assert np.allclose(kin.matrix_rpy(R), rpy)
 
 
 def test_right_legs_mirror_left_legs():

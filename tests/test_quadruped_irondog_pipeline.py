@@ -80,7 +80,7 @@ def test_run_files_carry_the_robot(report):
     assert wrench["frame_id"].iloc[0] == "world" and (wrench[[f"force_z.{leg}" for leg in ("FR", "FL", "BR", "BL")]]
                                                       >= -1e-9).all().all()
     # the trunk's pose on /body and on /tf agree
-    assert np.allclose(run["/body"]["value.z"].to_numpy()[::4][:len(tf)], tf["transforms.trunk.translation.z"])
+    assert np.allclose(run["/body"]["z"].to_numpy()[::4][:len(tf)], tf["transforms.trunk.translation.z"])
     failed = read_run(data_dir / f"runs/{SLUG}/stand/payload-7.5kg.mcap")
     assert failed.status.startswith("failed: fell at t = ") and "BR_tibia" in failed.status
     assert len(failed["/joint_state"]) > 10          # what happened before the fall is kept

@@ -94,14 +94,14 @@ def ik_round_trip(run: Run, figs: Figures) -> None:
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(10, 3.4))
     floor = 1e-16   # exact zeros are drawn here
     for form, color in (("printed", "C3"), ("corrected", "C0")):
-        e = run[f"/ik/bezier/{form}"]["value.fk_ik_error"]
+        e = run[f"/ik/bezier/{form}"]["value.fk_ik_error_m"]
         ax.semilogy(e.index, np.maximum(e * 1e3, floor), color=color, label=f"eq. (40) {form}")
     ax.set_xlabel("t [s] (swing)")
     ax.set_ylabel("‖FK(IK(p)) − p‖ [mm] (0 drawn at 1e-16)")
     ax.set_title("over the Table 3 swing")
     ax.legend(fontsize=7)
     ws = run["/ik/workspace"]
-    for column, form, color in (("printed_fk_ik_error", "printed", "C3"), ("fk_ik_error", "corrected", "C0")):
+    for column, form, color in (("printed_fk_ik_error_m", "printed", "C3"), ("fk_ik_error_m", "corrected", "C0")):
         e = np.maximum(ws[f"value.{column}"].dropna().to_numpy() * 1e3, floor)
         bx.hist(np.log10(e), bins=60, color=color, alpha=0.7, label=f"eq. (40) {form}")
     bx.set_xlabel("log10 ‖FK(IK(p)) − p‖ [mm]")
@@ -156,9 +156,8 @@ def table5_poses(runs: list[Run], figs: Figures) -> None:
         ax.set_xlabel(label)
     axes[0].set_ylabel("z [m]")
     axes[0].set_title("Table 5 / Fig. 16: ideal and standing (grey: MuJoCo, settled)", fontsize=9)
-    statics = run["/statics"].iloc[-1]
-    tau = run["/joint_state"][[f"effort.{j}" for j in JOINT_NAMES]].iloc[-200:].mean().to_numpy()
-    hand = np.array([statics[f"value.settled.{j}"] for j in JOINT_NAMES])
+    tau = columns(run["/joint_state"], "effort", JOINT_NAMES)[-200:].mean(axis=0)
+    hand = columns(run["/statics/torque"], "settled", JOINT_NAMES)[-1]
     x = np.arange(len(JOINT_NAMES))
     ax = axes[2]
     ax.bar(x - 0.2, np.abs(tau), 0.4, label="MuJoCo servo torque")
@@ -208,7 +207,7 @@ def body_poses(run: Run, figs: Figures) -> None:
     fig, axes = plt.subplots(2, 3, figsize=(12, 4.6), sharex=True)
     for ax, name in zip(axes.ravel(), ("x", "y", "z", "roll", "pitch", "yaw"), strict=True):
         scale, unit = (1e3, "mm") if name in "xyz" else (180 / np.pi, "deg")
-        achieved = (b[f"value.{name}"] - b[f"value.{name}"][stance].mean()) * scale
+        achieved = (b[name] - b[name][stance].mean()) * scale
         ax.plot(ref.index, ref[f"position.{name}"] * scale, "k--", lw=1, label="commanded")
         ax.plot(b.index, achieved, "C0", label="MuJoCo trunk")
         ax.set_ylabel(f"{name} [{unit}]")
@@ -232,9 +231,9 @@ def self_levelling(runs: list[Run], figs: Figures) -> None:
         for run in sorted((r for r in runs if r.metadata["case"].startswith(axis)), key=lambda r: r.run_id):
             b = run["/body"]
             style = "-" if "levelled" in run.run_id else ":"
-            top.plot(b.index, np.degrees(b[f"value.{axis}"]), style, label=f"trunk {axis}, {run.run_id}")
+            top.plot(b.index, np.degrees(b[axis]), style, label=f"trunk {axis}, {run.run_id}")
             if "levelled" in run.run_id:
-                bench = run["/platform"][f"value.{axis}"]
+                bench = run["/platform"][axis]
                 top.plot(bench.index, np.degrees(bench), "k--", lw=1, label=f"bench {axis}")
                 js = run["/joint_state"]
                 shown = ["FR_coxa", "FL_coxa"] if axis == "roll" else ["FR_femur", "FR_tibia", "BR_femur", "BR_tibia"]
@@ -262,7 +261,7 @@ def trot(run: Run, figs: Figures) -> None:
     # Fig. 22 and Fig. 12a
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 3.8))
     for name, color in (("roll", "C0"), ("pitch", "C1")):
-        ax.plot(t, np.degrees(b[f"value.{name}"]), color=color, label=f"{name}, MuJoCo")
+        ax.plot(t, np.degrees(b[name]), color=color, label=f"{name}, MuJoCo")
         low, high = paper_value(f"imu.trot.{name}_min", "deg"), paper_value(f"imu.trot.{name}_max", "deg")
         ax.axhspan(low, high, color=color, alpha=0.12, label=f"{name} range, real robot ({low:g}…{high:g}°)")
     ax.axvline(timing["trot_start"], color="k", lw=0.8, ls=":")

@@ -16,6 +16,7 @@ from analysis.core.figures import Figures
 from analysis.core.metrics import MetricTable
 from analysis.papers.quadruped_irondog import figures
 from analysis.papers.quadruped_irondog.readers import (
+    FEET,
     GRAVITY,
     body,
     columns,
@@ -32,7 +33,7 @@ from pipeline.papers.quadruped_irondog.kinematics import JOINT_NAMES, JOINTS, LE
 def torque_metrics(run: Run, window: np.ndarray) -> dict[str, tuple[float, str]]:
     """Servo output torques against the stall torque, over a window (bool mask of the log samples)."""
     tau = joints(run, field="effort")[window]
-    motor = columns(run["/servo/motor_torque"], "value", JOINT_NAMES)[window]
+    motor = joints(run, "/joint_state/motor", "effort")[window]
     limit = stall_torque(run)
     peak = np.abs(tau).max(axis=0)
     values = {"torque.peak": (peak.max(), "N*m"), "torque.peak_ratio": (peak.max() / limit, "ratio"),
@@ -59,7 +60,7 @@ def analyze_tables(runs: list[Run], figs: Figures) -> pd.DataFrame:
         t2 = rows[rows["table"] == "table2"].set_index("row")
         t6 = rows[rows["table"] == "table6"].set_index("row")
         fea = rows[rows["table"] == "fea"].set_index("row")
-        g = text["gravity"]
+        g = text["gravity_m_s2"]
         line_product = t6["value.unit_usd"] * t6["value.quantity"]
         E, nu = text["elastic_modulus_mpa"] * 1e6, text["poisson_ratio"]
         values = {
@@ -98,17 +99,14 @@ def analyze_kinematics(runs: list[Run], figs: Figures) -> pd.DataFrame:
     for run in runs:
         curve = run["/reference/bezier"]
         a, d = curve["position.a"].to_numpy(), curve["position.d"].to_numpy()
-        casteljau = columns(run["/bezier/de_casteljau"], "value", ["a", "d"])
+        casteljau = columns(run["/bezier/de_casteljau"], "value", ["a_m", "d_m"])
         apex = int(np.argmax(d))
         s = (curve.index.to_numpy() - curve.index[0]) / (curve.index[-1] - curve.index[0])
         workspace = run["/ik/workspace"]
-        corrected = run["/ik/bezier/corrected"]["value.fk_ik_error"]
-        printed = run["/ik/bezier/printed"]["value.fk_ik_error"]
-        table5 = run["/table5"]
-        standing = columns(table5[table5["value.state"] == 1], "value", [f"{leg}.{x}" for leg in LEGS
-                                                                          for x in "xyz"]).reshape(4, 3)
-        ideal = columns(table5[table5["value.state"] == 0], "value", [f"{leg}.{x}" for leg in LEGS
-                                                                       for x in "xyz"]).reshape(4, 3)
+        corrected = run["/ik/bezier/corrected"]["value.fk_ik_error_m"]
+        printed = run["/ik/bezier/printed"]["value.fk_ik_error_m"]
+        standing, ideal = (columns(run[f"/table5/{state}"], "position", FEET).reshape(4, 3)
+                           for state in ("standing", "ideal"))
         values = {
             "bezier.start.a": (a[0], "m"), "bezier.start.d": (d[0], "m"),
             "bezier.end.a": (a[-1], "m"), "bezier.end.d": (d[-1], "m"),
@@ -116,11 +114,11 @@ def analyze_kinematics(runs: list[Run], figs: Figures) -> pd.DataFrame:
             "bezier.apex.d": (d[apex], "m"), "bezier.apex.s": (s[apex], ""),
             "bezier.a_min": (a.min(), "m"), "bezier.a_max": (a.max(), "m"),
             "bezier.arc_length": (np.hypot(np.diff(a), np.diff(d)).sum(), "m"),
-            "ik.corrected.fk_ik_max": (max(workspace["value.fk_ik_error"].max(), corrected.max()), "m"),
-            "ik.corrected.ik_fk_max": (workspace["value.ik_fk_error"].max(), "rad"),
-            "ik.printed.fk_ik_max": (max(workspace["value.printed_fk_ik_error"].max(), printed.max()), "m"),
+            "ik.corrected.fk_ik_max": (max(workspace["value.fk_ik_error_m"].max(), corrected.max()), "m"),
+            "ik.corrected.ik_fk_max": (workspace["value.ik_fk_error_rad"].max(), "rad"),
+            "ik.printed.fk_ik_max": (max(workspace["value.printed_fk_ik_error_m"].max(), printed.max()), "m"),
             "ik.printed.fk_ik_max_bezier": (printed.max(), "m"),
-            "ik.printed.unreachable": (float(workspace["value.printed_fk_ik_error"].isna().sum()), "count"),
+            "ik.printed.unreachable": (float(workspace["value.printed_fk_ik_error_m"].isna().sum()), "count"),
             "ik.workspace_samples": (float(len(workspace)), "count"),
             "table5.standing.depth": (-standing[:, 2].mean(), "m"),
             "table5.standing.forward": (standing[:, 0].mean() - np.array([0.15, 0.15, -0.15, -0.15]).mean(), "m"),
@@ -153,9 +151,9 @@ def analyze_stand(runs: list[Run], figs: Figures) -> pd.DataFrame:
         fz = columns(wrench, "force_z", LEGS)[window].mean(axis=0)
         payload = float(run.metadata["case"].removeprefix("payload-").removesuffix("kg")) \
             if run.metadata["case"].startswith("payload") else 0.0
-        statics = run["/statics"].iloc[-1]
-        settled = np.array([statics[f"value.settled.{j}"] for j in JOINT_NAMES])
-        commanded = np.array([statics[f"value.commanded.{j}"] for j in JOINT_NAMES])
+        statics = run["/statics/torque"].iloc[-1]
+        settled = columns(statics.to_frame().T, "settled", JOINT_NAMES)[0]
+        commanded = columns(statics.to_frame().T, "commanded", JOINT_NAMES)[0]
         tau = joints(run, field="effort")[window].mean(axis=0)
         values = {
             "stand.roll": (b["roll"].mean(), "rad"), "stand.pitch": (b["pitch"].mean(), "rad"),
@@ -164,7 +162,7 @@ def analyze_stand(runs: list[Run], figs: Figures) -> pd.DataFrame:
             "stand.femur_left": (np.radians(paper[[1, 3], 1].mean()), "rad"),
             "stand.tibia": (np.radians(paper[:, 2].mean()), "rad"),
             "stand.coxa": (np.radians(paper[:, 0].mean()), "rad"),
-            "stand.joint_error_max": (np.abs(columns(run["/tracking_error"], "error", JOINT_NAMES)[window]
+            "stand.joint_error_max": (np.abs((joints(run, "/command", "value") - joints(run))[window]
                                              .mean(axis=0)).max(), "rad"),
             "stand.fz_sum": (fz.sum(), "N"), "stand.weight": ((robot_mass(run) + payload) * GRAVITY, "N"),
             "stand.fz_front": (fz[:2].mean(), "N"), "stand.fz_back": (fz[2:].mean(), "N"),
@@ -245,14 +243,19 @@ def analyze_self_levelling(runs: list[Run], figs: Figures) -> pd.DataFrame:
         bench_done = sc["tilt_start"] + sc["tilt_ramp"]
         last = t >= t[-1] - 1.0
         outside = np.flatnonzero((np.abs(tilt) > band) & (t >= sc["tilt_start"]))
-        settled_at = t[outside[-1]] if len(outside) else sc["tilt_start"]
+        if not len(outside):
+            settling = 0.0
+        elif outside[-1] == len(t) - 1:       # still tilted at the end: never settled
+            settling = float("nan")
+        else:
+            settling = max(0.0, t[outside[-1]] - bench_done)
         q = joints(run)
         dq = np.abs(q[last].mean(axis=0) - q[t < sc["tilt_start"]].mean(axis=0)).reshape(4, 3)
         values = {
             "level.residual": (np.abs(tilt[last]).mean(), "rad"),
             "level.peak": (np.abs(tilt).max(), "rad"),
-            "level.settling_time": (max(0.0, settled_at - bench_done), "s"),
-            "level.bench": (np.abs(run["/platform"][f"value.{axis}"].iloc[-1]), "rad"),
+            "level.settling_time": (settling, "s"),
+            "level.bench": (np.abs(run["/platform"][axis].iloc[-1]), "rad"),
             "level.other_axis_residual": (np.abs(b["pitch" if axis == "roll" else "roll"].to_numpy()[last]).mean(),
                                           "rad"),
             "level.coxa_change": (dq[:, 0].max(), "rad"),
@@ -298,8 +301,8 @@ def analyze_trot(runs: list[Run], figs: Figures) -> pd.DataFrame:
             values[f"trot.{angle}_max"] = (x.max(), "rad")
             values[f"trot.{angle}_rms"] = (np.sqrt(np.mean((x - x.mean()) ** 2)), "rad")
         values["trot.height_mean"] = (b["z"].to_numpy()[steady].mean(), "m")
-        # joints: command (held) minus measurement
-        error = columns(run["/tracking_error"], "error", JOINT_NAMES)[steady]
+        # joints: the servo command (held between control instants) minus the measurement (spec §7)
+        error = (joints(run, "/command", "value") - joints(run))[steady]
         values |= error_stats(ts, np.linalg.norm(error, axis=1), "joint_error.norm", "rad")
         for j, joint in enumerate(JOINTS):
             e = error[:, j::3]

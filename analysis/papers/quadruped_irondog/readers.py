@@ -24,10 +24,10 @@ def joints(run: Run, topic: str = "/joint_state", field: str = "position") -> np
 
 def body(run: Run) -> pd.DataFrame:
     """The trunk: x, y, z (m), roll, pitch, yaw (rad), vx, vy, vz (m/s), indexed by t."""
-    return run["/body"].rename(columns=lambda c: c.removeprefix("value."))
+    return run["/body"]
 
 
-def feet(run: Run, topic: str = "/feet", field: str = "value") -> np.ndarray:
+def feet(run: Run, topic: str = "/feet", field: str = "position") -> np.ndarray:
     """(N, 4, 3) foot positions in the leg frames."""
     return columns(run[topic], field, FEET).reshape(-1, 4, 3)
 
@@ -45,4 +45,4 @@ def stall_torque(run: Run) -> float:
 def trot_timing(run: Run) -> dict[str, float]:
     """cycle_time, swing_time, trot_start and steady_start (s) of a trot run."""
     frame = run["/gait/timing"].iloc[0]
-    return {k: float(frame[f"value.{k}"]) for k in ("cycle_time", "swing_time", "trot_start", "steady_start")}
+    return {k: float(frame[k]) for k in ("cycle_time", "swing_time", "trot_start", "steady_start")}

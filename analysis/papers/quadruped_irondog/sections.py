@@ -73,7 +73,7 @@ def _levelling(frame: pd.DataFrame) -> str:
     rows = [{"run": run_id, "bench [deg]": metric_value(frame, run_id, "level.bench") * DEG,
              "residual tilt [deg]": metric_value(frame, run_id, "level.residual") * DEG,
              "peak tilt [deg]": metric_value(frame, run_id, "level.peak") * DEG,
-             "settled after the bench stops [s]": metric_value(frame, run_id, "level.settling_time"),
+             "settled after the bench stops [s] (nan: never)": metric_value(frame, run_id, "level.settling_time"),
              "coxa change [deg]": metric_value(frame, run_id, "level.coxa_change") * DEG,
              "femur/tibia change [deg]": metric_value(frame, run_id, "level.femur_tibia_change") * DEG,
              "peak |τ| [N·m]": metric_value(frame, run_id, "torque.peak")}

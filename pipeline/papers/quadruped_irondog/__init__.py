@@ -80,5 +80,5 @@ LIMITS: dict[str, Range | OneOf] = {
     "scenario.ramp_cycles": Range(gt=0, le=20), "scenario.cycles": Range(ge=1, le=200),
     "scenario.skip_cycles": Range(ge=0, le=100),
     # tables: the paper's numbers as printed
-    "scenario.text.gravity": Range(gt=0, le=20),
+    "scenario.text.gravity_m_s2": Range(gt=0, le=20),
 }

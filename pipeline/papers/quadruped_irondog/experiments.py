@@ -22,12 +22,42 @@ from pipeline.papers.quadruped_irondog.simulation import Fall, Plant, Trace, sim
 from pipeline.papers.quadruped_irondog.statics import static_torques
 
 XYZ = ("x", "y", "z")
-BODY_FIELDS = ["x", "y", "z", "roll", "pitch", "yaw", "vx", "vy", "vz"]
 FEET_FIELDS = [f"{leg}.{a}" for leg in LEGS for a in XYZ]
 
 TableRow = schemas.define(
     "IronDogTableRow", "One row of a table printed in the paper, as printed (units in the column names).",
     table="string", row="string", name="string[]", value="double[]",
+)
+Trunk = schemas.define(
+    "IronDogTrunk", "The trunk (its IMU frame, at the centre of the hips) in the world: x, y, z (m); roll, pitch, "
+    "yaw (rad, R = Rz(yaw) Ry(pitch) Rx(roll)); linear velocity vx, vy, vz (m/s).",
+    x="double", y="double", z="double", roll="double", pitch="double", yaw="double", vx="double", vy="double",
+    vz="double",
+)
+Feet = schemas.define(
+    "IronDogFeet", "Foot positions (m) in each leg's frame (x lateral outward, y up, z forward, origin at the coxa "
+    "joint), from the measured joint angles.", name="string[]", position="double[]",
+)
+FeetInBody = schemas.define(
+    "IronDogFeetInBody", "Foot positions (m) in the body frame (x forward, y left, z up, origin at the hips' centre).",
+    name="string[]", position="double[]",
+)
+Bench = schemas.define("IronDogBench", "The tilting bench's angles (rad).", pitch="double", roll="double")
+Balance = schemas.define(
+    "IronDogBalance", "The body rotation (rad) the levelling PID commands through body IK.", roll="double",
+    pitch="double",
+)
+StaticTorque = schemas.define(
+    "IronDogStaticTorque", "Hand statics of a standing pose: servo torque (N·m) per joint, at the commanded pose "
+    "and at the pose MuJoCo settled in.", name="string[]", commanded="double[]", settled="double[]",
+)
+StaticLoad = schemas.define(
+    "IronDogStaticLoad", "Hand statics of a standing pose: vertical load (N) per foot, at the commanded pose and at "
+    "the pose MuJoCo settled in.", name="string[]", commanded="double[]", settled="double[]",
+)
+GaitTiming = schemas.define(
+    "IronDogGaitTiming", "A trot run's timing (s): step cycle, swing, when the trot starts, when the steady window "
+    "starts.", cycle_time="double", swing_time="double", trot_start="double", steady_start="double",
 )
 
 
@@ -76,27 +106,29 @@ def log_trace(log: RunWriter, plant: Plant, trace: Trace, cfg: DictConfig, q_ref
     t, leg = trace.t, plant.robot.leg
     log.log_series("/joint_state", t, name=JOINT_NAMES, position=trace.q, velocity=trace.qd, effort=trace.tau)
     log.log_series("/command", t, kind="position", name=JOINT_NAMES, value=trace.q_cmd)
-    log.log_series("/reference", t, name=JOINT_NAMES, position=trace.q_cmd if q_ref is None else q_ref)
-    error = trace.q_cmd - trace.q
+    reference = trace.q_cmd if q_ref is None else q_ref
+    log.log_series("/reference", t, name=JOINT_NAMES, position=reference)
+    error = reference - trace.q
     log.log_series("/tracking_error", t, name=JOINT_NAMES, error=error, norm=np.linalg.norm(error, axis=1))
-    log.log_series("/servo/motor_torque", t, schemas.Scalars, name=JOINT_NAMES, value=trace.tau_motor)
+    log.log_series("/joint_state/motor", t, name=JOINT_NAMES, effort=trace.tau_motor)   # the saturating part
     f = trace.contact_force
     log.log_series("/wrench", t, frame_id="world", name=list(LEGS), force_x=f[..., 0], force_y=f[..., 1],
                    force_z=f[..., 2], torque_x=np.zeros_like(f[..., 0]), torque_y=np.zeros_like(f[..., 0]),
                    torque_z=np.zeros_like(f[..., 0]))
     log.log_series("/contact", t, schemas.Scalars, name=list(LEGS), value=trace.contact)
-    body = np.column_stack([trace.qpos[:, :3], trace.rpy, trace.trunk_velocity[:, :3]])
-    log.log_series("/body", t, schemas.Scalars, name=BODY_FIELDS, value=body)
+    rpy, v = trace.rpy, trace.trunk_velocity
+    log.log_series("/body", t, Trunk, x=trace.qpos[:, 0], y=trace.qpos[:, 1], z=trace.qpos[:, 2], roll=rpy[:, 0],
+                   pitch=rpy[:, 1], yaw=rpy[:, 2], vx=v[:, 0], vy=v[:, 1], vz=v[:, 2])
     feet = kin.fk(leg, trace.q.reshape(-1, 4, 3))
-    log.log_series("/feet", t, schemas.Scalars, name=FEET_FIELDS, value=feet.reshape(len(t), -1))
+    log.log_series("/feet", t, Feet, name=FEET_FIELDS, position=feet.reshape(len(t), -1))
     if feet_ref is not None:
         log.log_series("/reference/feet", t, name=FEET_FIELDS, position=feet_ref.reshape(len(t), -1))
         e = feet_ref - feet
         log.log_series("/tracking_error/feet", t, name=FEET_FIELDS, error=e.reshape(len(t), -1),
                        norm=np.linalg.norm(e.reshape(len(t), -1), axis=1))
     if len(plant.idx.platform_qpos):
-        log.log_series("/platform", t, schemas.Scalars, name=["pitch", "roll"],
-                       value=trace.qpos[:, plant.idx.platform_qpos])
+        bench = trace.qpos[:, plant.idx.platform_qpos]
+        log.log_series("/platform", t, Bench, pitch=bench[:, 0], roll=bench[:, 1])
     every = max(1, round(cfg.system.log.rate_hz / cfg.system.log.tf_rate_hz))
     poses = plant.poses(trace.qpos[::every])
     bodies = plant.idx.bodies
@@ -150,7 +182,7 @@ def kinematics(cfg: DictConfig) -> list[Case]:
         casteljau = np.array([de_casteljau(P, x) for x in s])
         times = s * trot.swing_time
         log.log_series("/reference/bezier", times, name=["a", "d"], position=curve)
-        log.log_series("/bezier/de_casteljau", times, schemas.Scalars, name=["a", "d"], value=casteljau)
+        log.log_series("/bezier/de_casteljau", times, schemas.Scalars, name=["a_m", "d_m"], value=casteljau)
         # the swing in the leg frame and its joint angles, with both forms of eq. (40)
         phase = s * trot.swing_fraction
         swing = np.stack([np.full_like(s, trot.lateral), trot.curve(phase)[:, 1],
@@ -159,7 +191,7 @@ def kinematics(cfg: DictConfig) -> list[Case]:
         log.log_series("/reference", times, name=list(kin.JOINTS), position=q)
         for name, leg in (("corrected", corrected), ("printed", printed)):
             err = np.linalg.norm(kin.fk(corrected, kin.ik(leg, swing)) - swing, axis=1)
-            log.log_series(f"/ik/bezier/{name}", times, schemas.Scalars, name=["fk_ik_error"], value=err[:, None])
+            log.log_series(f"/ik/bezier/{name}", times, schemas.Scalars, name=["fk_ik_error_m"], value=err[:, None])
         # the workspace: random poses on the IK's branch (θ3 ∈ (0, π), foot below the femur joint)
         rng = np.random.default_rng(cfg.seed)
         lo, hi = robot.ranges[:, 0], robot.ranges[:, 1]
@@ -172,13 +204,12 @@ def kinematics(cfg: DictConfig) -> list[Case]:
                   np.abs(kin.ik(corrected, p_ws) - q_ws).max(axis=1),
                   np.linalg.norm(kin.fk(corrected, kin.ik(printed, p_ws)) - p_ws, axis=1)]
         log.log_series("/ik/workspace", sample_t, schemas.Scalars,
-                       name=["fk_ik_error", "ik_fk_error", "printed_fk_ik_error"], value=np.column_stack(values))
-        # Table 5 in the leg and body frames
-        for k, state in enumerate(("ideal", "standing")):
-            pose = table5_pose(cfg, state)
-            feet = kin.feet_in_body(corrected, robot.layout, pose)
-            log.log("/table5", float(k), schemas.Scalars, name=["state", *FEET_FIELDS],
-                    value=[float(k), *feet.ravel().tolist()])
+                       name=["fk_ik_error_m", "ik_fk_error_rad", "printed_fk_ik_error_m"],
+                       value=np.column_stack(values))
+        # Table 5's feet in the body frame
+        for state in ("ideal", "standing"):
+            feet = kin.feet_in_body(corrected, robot.layout, table5_pose(cfg, state))
+            log.log(f"/table5/{state}", 0.0, FeetInBody, name=FEET_FIELDS, position=feet.ravel().tolist())
         # per call: one leg's IK (scalar), a batch of 4 legs, the Bezier at one s
         point = swing[len(swing) // 2]
         feet4 = np.tile(point, (4, 1))
@@ -207,12 +238,13 @@ def stand(cfg: DictConfig) -> list[Case]:
         trace = simulate(plant, lambda t, rpy: q_stand, sc.duration, control_dt, log_dt, fall_of(cfg))
         log_trace(log, plant, trace, cfg)
         # the hand statics at the commanded pose, and at the pose MuJoCo settled in
-        names = [f"{kind}.{joint}" for kind in ("commanded", "settled") for joint in JOINT_NAMES] + \
-                [f"{kind}.load.{leg}" for kind in ("commanded", "settled") for leg in LEGS]
         tau_cmd, load_cmd = static_torques(robot, q_stand, payload)
         tau_set, load_set = static_torques(robot, trace.q[-1].reshape(4, 3), payload, trace.rpy[-1])
-        log.log("/statics", float(trace.t[-1]), schemas.Scalars, name=names,
-                value=np.concatenate([tau_cmd.ravel(), tau_set.ravel(), load_cmd, load_set]).tolist())
+        end = float(trace.t[-1])
+        log.log("/statics/torque", end, StaticTorque, name=JOINT_NAMES, commanded=tau_cmd.ravel().tolist(),
+                settled=tau_set.ravel().tolist())
+        log.log("/statics/load", end, StaticLoad, name=list(LEGS), commanded=load_cmd.tolist(),
+                settled=load_set.tolist())
         finish(trace)
 
     return [Case("robot" if not p else f"payload-{p:g}kg", lambda log, p=float(p): simulate_(log, p))
@@ -294,8 +326,8 @@ def self_levelling(cfg: DictConfig) -> list[Case]:
 
         trace = simulate(plant, controller, sc.duration, control_dt, log_dt, fall_of(cfg), platform=bench)
         log_trace(log, plant, trace, cfg)
-        log.log_series("/balance", trace.control_t, schemas.Scalars, name=["roll_offset", "pitch_offset"],
-                       value=np.array(outputs)[:len(trace.control_t)])
+        offsets = np.array(outputs)[:len(trace.control_t)]
+        log.log_series("/balance", trace.control_t, Balance, roll=offsets[:, 0], pitch=offsets[:, 1])
         finish(trace)
 
     return [Case(f"{axis}-{'levelled' if enabled else 'open-loop'}",
@@ -325,10 +357,11 @@ def trot(cfg: DictConfig) -> list[Case]:
         q_ref = kin.ik(robot.leg, feet_ref).reshape(len(trace.t), -1)
         log_trace(log, plant, trace, cfg, q_ref=q_ref, feet_ref=feet_ref)
         steady = controller.start + (sc.ramp_cycles + sc.skip_cycles) * gait.period
-        log.log("/gait/timing", 0.0, schemas.Scalars, name=["cycle_time", "swing_time", "trot_start", "steady_start"],
-                value=[gait.period, gait.swing_time, controller.start, steady])
+        log.log("/gait/timing", 0.0, GaitTiming, cycle_time=gait.period, swing_time=gait.swing_time,
+                trot_start=controller.start, steady_start=steady)
         log.log_series("/gait", trace.t, schemas.Scalars,
                        name=[*(f"swing.{leg}" for leg in LEGS), *(f"phase.{leg}" for leg in LEGS), "stride_scale"],
+                       # swing: 1 in swing; phase: share of the cycle; stride_scale: share of the paper's stride
                        value=np.column_stack([swing, gait.phase(np.maximum(trace.t - controller.start, 0.0)),
                                               controller.stride(trace.t)]))
         finish(trace)

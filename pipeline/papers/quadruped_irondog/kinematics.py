@@ -115,13 +115,6 @@ def rpy_matrix(rpy) -> np.ndarray:
         np.stack([-sp, cp * sr, cp * cr], axis=-1)], axis=-2)
 
 
-def matrix_rpy(R) -> np.ndarray:
-    """(..., 3) roll, pitch, yaw of rotation matrices (the inverse of `rpy_matrix` for |pitch| < π/2)."""
-    R = np.asarray(R, dtype=float)
-    return np.stack([np.arctan2(R[..., 2, 1], R[..., 2, 2]), -np.arcsin(np.clip(R[..., 2, 0], -1.0, 1.0)),
-                     np.arctan2(R[..., 1, 0], R[..., 0, 0])], axis=-1)
-
-
 def body_ik(leg: Leg, layout: Layout, feet, position, rpy) -> np.ndarray:
     """Body IK (Sec. 3.2, Fig. 18): joint angles (..., 4, 3) that put the trunk at `position` (..., 3) with
     orientation `rpy` (..., 3) while the feet stay at `feet` (4, 3), all in the stance frame (the frame the feet

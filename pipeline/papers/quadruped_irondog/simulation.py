@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -59,7 +59,6 @@ class Trace:
     control_t: np.ndarray       # (M,) control instants
     control_seconds: np.ndarray  # (M,) wall time of each controller call
     failure: str | None = None
-    extras: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def rpy(self) -> np.ndarray:
