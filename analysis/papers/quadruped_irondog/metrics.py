@@ -334,5 +334,6 @@ def analyze_trot(runs: list[Run], figs: Figures) -> pd.DataFrame:
         step = run["/compute_time"]["seconds.control_step"].to_numpy()
         values |= timing_metrics("time.control_step", step)
         m.add_run(run, values)
-        figures.trot(run, figs)
+        if np.isclose(timing["cycle_time"], run.config["system"]["gait"]["cycle_time"]):
+            figures.trot(run, figs)
     return m.frame()

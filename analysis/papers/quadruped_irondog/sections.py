@@ -104,13 +104,24 @@ TROT_ROWS = [  # (metric, label, factor)
 
 
 def _trot(frame: pd.DataFrame, runs: pd.DataFrame) -> str:
-    run_ids = sorted(set(frame["run_id"]))
+    run_ids = sorted(set(frame["run_id"]), key=_cycle)
     table = pd.DataFrame([{"": label, **{r: metric_value(frame, r, metric) * factor for r in run_ids}}
                           for metric, label, factor in TROT_ROWS])
     return ("## Trot on flat ground (Sec. 4.3, Figs. 21-22)\n\nOver the steady window (after the stride ramp and "
             "one more cycle). Joint errors: servo command minus joint angle; foot errors: the continuous Table 3 "
-            "swing / straight stance minus the FK of the measured joints, in the leg frames. A trot run that fell "
-            "has no row here: its status is in the run list.\n\n" + table.to_markdown(index=False, floatfmt=".3g"))
+            "swing / straight stance minus the FK of the measured joints, in the leg frames. Runs that fell have no "
+            "column here:\n\n" + _falls(runs) + "\n\n" + table.to_markdown(index=False, floatfmt=".3g"))
+
+
+def _cycle(run_id: str) -> float:
+    return float(run_id.removeprefix("cycle-").split("s")[0])
+
+
+def _falls(runs: pd.DataFrame) -> str:
+    trot = runs[runs["experiment"] == "trot"].copy()
+    trot["step cycle [s]"] = trot["run_id"].map(_cycle)
+    trot["outcome"] = trot["status"].where(~trot["ok"], "walks the whole run")
+    return trot.sort_values("step cycle [s]")[["step cycle [s]", "outcome"]].to_markdown(index=False)
 
 
 def _kinematics(frame: pd.DataFrame) -> str:
