@@ -197,7 +197,7 @@ def kinematics(cfg: DictConfig) -> list[Case]:
         lo, hi = robot.ranges[:, 0], robot.ranges[:, 1]
         q_ws = rng.uniform(np.maximum(lo, [-np.pi / 2, -np.pi / 2, 0.05]), np.minimum(hi, [np.pi / 2, np.pi / 2, 3.0]),
                            (sc.workspace_samples, 3))
-        q_ws = q_ws[kin.fk(Leg(0.0, robot.leg.L2, robot.leg.L3), q_ws)[:, 1] < 0][:, :]
+        q_ws = q_ws[kin.fk(Leg(0.0, robot.leg.L2, robot.leg.L3), q_ws)[:, 1] < 0]
         p_ws = kin.fk(corrected, q_ws)
         sample_t = np.arange(len(q_ws)) * 1e-3
         values = [np.linalg.norm(kin.fk(corrected, kin.ik(corrected, p_ws)) - p_ws, axis=1),

@@ -164,11 +164,12 @@ def simulate(plant: Plant, controller: Controller, duration: float, control_dt: 
                     failure += f" (servos at their {plant.robot.stall_torque:.2f} N·m limit: {', '.join(saturated)})"
                 break
     if failure is None:
+        from pipeline.core.runlog import SimulationFailed
         from pipeline.robotics.mjcf import check_mujoco
 
         try:
             check_mujoco(d, rec["qpos"][:k], log_steps[:k] * h)
-        except RuntimeError as err:   # SimulationFailed: keep the trace, say why
+        except SimulationFailed as err:   # keep the trace, say why
             failure = str(err)
     return Trace(t=log_steps[:k] * h, qpos=rec["qpos"][:k], q=rec["q"][:k], qd=rec["qd"][:k], tau=rec["tau"][:k],
                  tau_motor=rec["tau_motor"][:k], q_cmd=rec["q_cmd"][:k], trunk_velocity=rec["vel"][:k],
