@@ -99,3 +99,11 @@ def test_the_bench_tilts_the_ground():
     bench = trace.qpos[-1, plant.idx.platform_qpos]
     assert bench[0] == pytest.approx(tilt, abs=2e-3) and abs(bench[1]) < 1e-3
     assert trace.rpy[-1, 1] == pytest.approx(tilt, abs=np.radians(1.5))   # open loop: the trunk tilts with it
+
+
+def test_an_unreachable_reference_stops_the_run_with_its_reason():
+    plant = Plant(ROBOT, Scene())
+    plant.place(STAND)
+    far = kin.ik(ROBOT.leg, np.tile([ROBOT.leg.L1, -0.4, 0.0], (4, 1)))      # 0.4 m below a 0.29 m leg
+    trace = simulate(plant, lambda t, rpy: STAND if t < 0.1 else far, 0.5, 0.02, 0.01, FALL)
+    assert trace.failure == "no IK solution at t = 0.10 s: the feet of BL, BR, FL, FR are out of reach"

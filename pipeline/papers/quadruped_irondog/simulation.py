@@ -133,9 +133,14 @@ def simulate(plant: Plant, controller: Controller, duration: float, control_dt: 
             if platform is not None:
                 d.ctrl[idx.platform_ctrl] = platform(t)
             begin = clock()
-            d.ctrl[:12] = np.ravel(controller(t, rpy))
+            command = np.ravel(controller(t, rpy))
             control_seconds[c] = (clock() - begin) * 1e-9
             c += 1
+            if not np.isfinite(command).all():
+                legs = sorted({JOINT_NAMES[i].split("_")[0] for i in np.flatnonzero(~np.isfinite(command))})
+                failure = f"no IK solution at t = {t:.2f} s: the feet of {', '.join(legs)} are out of reach"
+                break
+            d.ctrl[:12] = command
         if is_log[j]:
             mj.mj_forward(m, d)
             rec["qpos"][k] = d.qpos
