@@ -6,7 +6,7 @@
 Rerun also opens the .mcap directly (`rerun <run>.mcap`): it draws /tf and decodes every other channel as
 queryable fields. This converter adds what reflection cannot: every numeric column as a time series on a
 `sim_time` timeline, the /tf frames as a 3-D skeleton (frames joined in the order they are logged), and the
-spheres and cylinders of `/markers` (Foxglove SceneUpdate) drawn in the /tf frame each entity names.
+cubes, spheres and cylinders of `/markers` (Foxglove SceneUpdate) drawn in the /tf frame each entity names.
 """
 
 from __future__ import annotations
@@ -57,6 +57,14 @@ def _log_markers(rec: rr.RecordingStream, run_path: Path) -> None:
                         centers=[[s.pose.position.x, s.pose.position.y, s.pose.position.z] for s in entity.spheres],
                         half_sizes=[[s.size.x / 2, s.size.y / 2, s.size.z / 2] for s in entity.spheres],
                         colors=[_rgba(s.color) for s in entity.spheres]))
+                if entity.cubes:
+                    c = entity.cubes
+                    rec.log(f"{path}/cubes", rr.Boxes3D(
+                        half_sizes=[[x.size.x / 2, x.size.y / 2, x.size.z / 2] for x in c],
+                        centers=[[x.pose.position.x, x.pose.position.y, x.pose.position.z] for x in c],
+                        quaternions=[[x.pose.orientation.x, x.pose.orientation.y, x.pose.orientation.z,
+                                      x.pose.orientation.w] for x in c],
+                        colors=[_rgba(x.color) for x in c], fill_mode="solid"))
                 if entity.cylinders:
                     c = entity.cylinders
                     rec.log(f"{path}/cylinders", rr.Cylinders3D(

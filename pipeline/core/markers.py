@@ -1,5 +1,6 @@
 """Shapes to draw on `/markers` (Foxglove SceneUpdate): Foxglove's 3D panel renders them natively, and
-`python -m analysis.view` draws them in Rerun. An entity lives in a /tf frame and moves with it."""
+`python -m analysis.view` draws them in Rerun. An entity lives in a /tf frame and moves with it; `mujoco_geoms`
+draws a generated MuJoCo model from its own geoms."""
 
 from __future__ import annotations
 
@@ -74,3 +75,52 @@ def cone(frame: str, name: str, start: Sequence[float], end: Sequence[float], ra
     """A truncated cone from `start` (radius_start) to `end` (radius_end) in /tf frame `frame`."""
     return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True,
                                cylinders=[_cylinder(start, end, radius_start, radius_end, color)])
+def _pose(pos: Sequence[float], quat_wxyz: Sequence[float]):
+    return schemas.Pose(position=schemas.Vector3(x=pos[0], y=pos[1], z=pos[2]),
+                        orientation=schemas.Quaternion(w=quat_wxyz[0], x=quat_wxyz[1], y=quat_wxyz[2], z=quat_wxyz[3]))
+
+
+def mujoco_geoms(model, plane_size: float = 4.0) -> list:
+    """Every geom of a compiled MuJoCo model, drawn in the /tf frame named as its body (`world` for the world
+    body's): boxes as cubes, spheres, cylinders, capsules as a cylinder with two end spheres, planes as a thin
+    `plane_size` square slab whose top is the plane. One entity per body; log the bodies' poses on /tf."""
+    import mujoco
+
+    entities: dict[int, schemas.SceneEntity] = {}
+    box, sphere, cylinder, capsule, plane = (int(k) for k in (
+        mujoco.mjtGeom.mjGEOM_BOX, mujoco.mjtGeom.mjGEOM_SPHERE, mujoco.mjtGeom.mjGEOM_CYLINDER,
+        mujoco.mjtGeom.mjGEOM_CAPSULE, mujoco.mjtGeom.mjGEOM_PLANE))
+    for g in range(model.ngeom):
+        body = int(model.geom_bodyid[g])
+        frame = "world" if body == 0 else mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body)
+        entity = entities.setdefault(body, schemas.SceneEntity(frame_id=frame, id=f"geoms/{frame}",
+                                                               frame_locked=True))
+        kind, size, pos, quat = int(model.geom_type[g]), model.geom_size[g], model.geom_pos[g], model.geom_quat[g]
+        color = _color(model.geom_rgba[g])
+        if kind == box:
+            entity.cubes.append(schemas.CubePrimitive(pose=_pose(pos, quat), color=color, size=schemas.Vector3(
+                x=2 * size[0], y=2 * size[1], z=2 * size[2])))
+        elif kind == sphere:
+            d = 2 * size[0]
+            entity.spheres.append(schemas.SpherePrimitive(pose=_pose(pos, quat), color=color,
+                                                          size=schemas.Vector3(x=d, y=d, z=d)))
+        elif kind in (cylinder, capsule):
+            d = 2 * size[0]
+            entity.cylinders.append(schemas.CylinderPrimitive(pose=_pose(pos, quat), color=color, size=schemas.Vector3(
+                x=d, y=d, z=2 * size[1]), bottom_scale=1.0, top_scale=1.0))
+            if kind == capsule:
+                for sign in (1.0, -1.0):
+                    end = pos + sign * size[1] * _z_axis(quat)
+                    entity.spheres.append(schemas.SpherePrimitive(pose=_pose(end, quat), color=color,
+                                                                  size=schemas.Vector3(x=d, y=d, z=d)))
+        elif kind == plane:
+            below = pos - 0.001 * _z_axis(quat)
+            entity.cubes.append(schemas.CubePrimitive(pose=_pose(below, quat), color=color, size=schemas.Vector3(
+                x=plane_size, y=plane_size, z=0.002)))
+    return list(entities.values())
+
+
+def _z_axis(quat_wxyz: Sequence[float]) -> np.ndarray:
+    """The local z axis of a unit quaternion's frame."""
+    w, x, y, z = quat_wxyz
+    return np.array([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
