@@ -3,30 +3,16 @@ the robot drawn as a stick figure from its /tf frames (hips, knees, feet)."""
 
 from __future__ import annotations
 
-import functools
-from pathlib import Path
-
 import numpy as np
 
 from analysis.core.figures import Figures, plt
-from analysis.core.targets import load_targets
-from analysis.core.units import convert
-from analysis.papers.quadruped_irondog.readers import columns, feet, robot_mass, trot_timing
+from analysis.core.targets import paper_value
+from analysis.papers.quadruped_irondog.metrics import columns, feet, robot_mass, trot_timing
 from pipeline.core.runlog import Run
 from pipeline.papers.quadruped_irondog.kinematics import JOINT_NAMES, LEGS, Layout, Leg, feet_in_body, fk, leg_to_body
 
+SLUG = "quadruped-irondog"
 LEG_COLORS = {"FR": "C3", "FL": "C0", "BR": "C1", "BL": "C2"}
-
-
-@functools.cache
-def _targets():
-    return load_targets(Path(__file__).with_name("targets.csv")).set_index("target_id")
-
-
-def paper_value(target_id: str, unit: str) -> float:
-    """A number the paper prints (targets.csv), in `unit`: drawn beside the pipeline's curves, never retyped."""
-    row = _targets().loc[target_id]
-    return convert(float(row["value"]), row["unit"], unit)
 
 
 def _xyz(frame, prefix: str) -> np.ndarray:
@@ -262,8 +248,9 @@ def trot(run: Run, figs: Figures) -> None:
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 3.8))
     for name, color in (("roll", "C0"), ("pitch", "C1")):
         ax.plot(t, np.degrees(b[name]), color=color, label=f"{name}, MuJoCo")
-        low, high = paper_value(f"imu.trot.{name}_min", "deg"), paper_value(f"imu.trot.{name}_max", "deg")
-        ax.axhspan(low, high, color=color, alpha=0.12, label=f"{name} range, real robot ({low:g}…{high:g}°)")
+        low, high = (paper_value(SLUG, f"imu.trot.{name}_{end}", "deg") for end in ("min", "max"))
+        ax.axhspan(low, high, color=color, alpha=0.12,
+                   label=f"paper: {name} range of the real robot ({low:g}…{high:g}°)")
     ax.axvline(timing["trot_start"], color="k", lw=0.8, ls=":")
     ax.axvline(timing["steady_start"], color="k", lw=0.8, ls="--")
     ax.set_xlabel("t [s] (dotted: trot starts; dashed: steady window)")

@@ -8,13 +8,15 @@ import pandas as pd
 
 from analysis.core.compute_time import compute_time_section, machine_of
 from analysis.core.metrics import metric_value
-from analysis.papers.quadruped_irondog.figures import paper_value
+from analysis.core.sections import Section, Table
+from analysis.core.targets import paper_value
 from pipeline.papers.quadruped_irondog.kinematics import JOINT_NAMES
 
+SLUG = "quadruped-irondog"
 DEG = 180 / np.pi
 
 
-def _imu(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> str:
+def _imu(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> Section:
     rows = []
     for quantity, target, experiment, run_id, metric in (
             ("trot: min roll", "imu.trot.roll_min", "trot", "cycle-0.5s", "trot.roll_min"),
@@ -25,18 +27,20 @@ def _imu(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> str:
             ("standing: roll", "imu.stand.roll", "stand", "robot", "stand.roll")):
         frame = metrics.get(experiment)
         simulated = metric_value(frame, run_id, metric) * DEG if frame is not None else float("nan")
-        rows.append({"quantity": quantity, "real robot [deg]": paper_value(target, "deg"),
-                     "MuJoCo [deg]": simulated, "MuJoCo run": f"{experiment}/{run_id}"})
+        rows.append({"quantity": quantity, "target": target,
+                     "paper: real robot [deg]": paper_value(SLUG, target, "deg"),
+                     "MuJoCo stand-in [deg]": simulated, "MuJoCo run": f"{experiment}/{run_id}"})
     failed = runs[(runs["experiment"] == "trot") & ~runs["ok"]] if not runs.empty else runs
     note = "".join(f" Run `trot/{r.run_id}` {r.status}." for r in failed.itertuples())
-    return ("## IMU: the real robot and the simulation\n\nThe paper's only motion numbers come from the real robot's "
-            "MPU-6050 (Fig. 22, Sec. 4.3): not reproducible in simulation. Beside them, the MuJoCo robot over the "
-            "steady trot and the settled stance — a stand-in, not a reproduction (no six-bar; assumed servo, gait "
-            "timing and mass distribution)." + note + "\n\n"
-            + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".2f"))
+    return Section("IMU: the real robot and a simulated stand-in",
+                   "The paper's only motion numbers come from the real robot's MPU-6050 (Fig. 22, Sec. 4.3): not "
+                   "reproducible in simulation (the targets above are `not-reproducible`). Beside them, the MuJoCo "
+                   "robot over the steady trot and the settled stance — a stand-in, not a reproduction, and not "
+                   "judged (no six-bar; assumed servo, gait timing and mass distribution)." + note,
+                   Table(pd.DataFrame(rows), ".2f"), category="tracking errors")
 
 
-def _stand(frame: pd.DataFrame) -> str:
+def _stand(frame: pd.DataFrame) -> Section:
     rows = [{"joint": j, "MuJoCo servo torque [N·m]": metric_value(frame, "robot", f"stand.torque.{j}"),
              "hand statics [N·m]": metric_value(frame, "robot", f"stand.statics.{j}")} for j in JOINT_NAMES]
     fz = {k: metric_value(frame, "robot", f"stand.{k}") for k in ("fz_front", "fz_back", "fz_sum", "weight")}
@@ -44,13 +48,13 @@ def _stand(frame: pd.DataFrame) -> str:
              f"Σ {fz['fz_sum']:.3f} N against m g = {fz['weight']:.3f} N. The feet stand 35 mm ahead of the hips in "
              "the Table 5 pose, so the rear legs carry more and sag more (the trunk pitches nose-up). The "
              "SPT5535LV's stall torque is 3.43 N·m.")
-    return ("## Standing in the Table 5 pose (robot only)\n\nServo torques of the settled MuJoCo robot against the "
-            "hand statics at the same pose (pipeline/papers/quadruped_irondog/statics.py: lumped masses, leg "
-            "Jacobians, least-norm foot loads).\n\n" + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".4f")
-            + "\n\n" + loads)
+    return Section("Standing in the Table 5 pose (robot only)",
+                   "Servo torques of the settled MuJoCo robot against the hand statics at the same pose "
+                   "(pipeline/papers/quadruped_irondog/statics.py: lumped masses, leg Jacobians, least-norm foot "
+                   "loads).", Table(pd.DataFrame(rows), ".4f"), loads, category="trajectories")
 
 
-def _poses(frame: pd.DataFrame) -> str:
+def _poses(frame: pd.DataFrame) -> Section:
     rows = []
     for k in range(2, 13):
         commanded = metric_value(frame, "fig18", f"pose.{k}.commanded")
@@ -64,12 +68,13 @@ def _poses(frame: pd.DataFrame) -> str:
                          metric_value(frame, "fig18", f"pose.{k}.crosstalk_translation") * 1e3,
                      "cross-talk, rotation [deg]": metric_value(frame, "fig18", f"pose.{k}.crosstalk_rotation") * DEG})
     slip = metric_value(frame, "fig18", "pose.foot_slip_max") * 1e3
-    return ("## Body poses (Fig. 18)\n\nHeld trunk offset (mean over each hold, from the pose just before the "
-            "scenario) against the command; the feet stay where the stance put them (largest horizontal foot "
-            f"displacement {slip:.1f} mm).\n\n" + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".2f"))
+    return Section("Body poses (Fig. 18)",
+                   "Held trunk offset (mean over each hold, from the pose just before the scenario) against the "
+                   "command; the feet stay where the stance put them (largest horizontal foot displacement "
+                   f"{slip:.1f} mm).", Table(pd.DataFrame(rows), ".2f"), category="trajectories")
 
 
-def _levelling(frame: pd.DataFrame) -> str:
+def _levelling(frame: pd.DataFrame) -> Section:
     rows = [{"run": run_id, "bench [deg]": metric_value(frame, run_id, "level.bench") * DEG,
              "residual tilt [deg]": metric_value(frame, run_id, "level.residual") * DEG,
              "peak tilt [deg]": metric_value(frame, run_id, "level.peak") * DEG,
@@ -78,9 +83,9 @@ def _levelling(frame: pd.DataFrame) -> str:
              "femur/tibia change [deg]": metric_value(frame, run_id, "level.femur_tibia_change") * DEG,
              "peak |τ| [N·m]": metric_value(frame, run_id, "torque.peak")}
             for run_id in sorted(set(frame["run_id"]))]
-    return ("## Self-levelling on a tilting bench (Figs. 19-20)\n\nResidual tilt: mean |angle| over the last 1 s; "
-            "settled: the last time the tilt left the ±1° band, after the bench stopped.\n\n"
-            + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".3g"))
+    return Section("Self-levelling on a tilting bench (Figs. 19-20)",
+                   "Residual tilt: mean |angle| over the last 1 s; settled: the last time the tilt left the ±1° band, "
+                   "after the bench stopped.", Table(pd.DataFrame(rows), ".3g"), category="tracking errors")
 
 
 TROT_ROWS = [  # (metric, label, factor)
@@ -103,28 +108,29 @@ TROT_ROWS = [  # (metric, label, factor)
 ]
 
 
-def _trot(frame: pd.DataFrame, runs: pd.DataFrame) -> str:
+def _trot(frame: pd.DataFrame, runs: pd.DataFrame) -> Section:
     run_ids = sorted(set(frame["run_id"]), key=_cycle)
     table = pd.DataFrame([{"": label, **{r: metric_value(frame, r, metric) * factor for r in run_ids}}
                           for metric, label, factor in TROT_ROWS])
-    return ("## Trot on flat ground (Sec. 4.3, Figs. 21-22)\n\nOver the steady window (after the stride ramp and "
-            "one more cycle). Joint errors: servo command minus joint angle; foot errors: the continuous Table 3 "
-            "swing / straight stance minus the FK of the measured joints, in the leg frames. Runs that fell have no "
-            "column here:\n\n" + _falls(runs) + "\n\n" + table.to_markdown(index=False, floatfmt=".3g"))
+    return Section("Trot on flat ground (Sec. 4.3, Figs. 21-22)",
+                   "Over the steady window (after the stride ramp and one more cycle). Joint errors: servo command "
+                   "minus joint angle; foot errors: the continuous Table 3 swing / straight stance minus the FK of the "
+                   "measured joints, in the leg frames. Runs that fell have no column here:", _falls(runs),
+                   Table(table, ".3g"), category="trajectories")
 
 
 def _cycle(run_id: str) -> float:
     return float(run_id.removeprefix("cycle-").split("s")[0])
 
 
-def _falls(runs: pd.DataFrame) -> str:
+def _falls(runs: pd.DataFrame) -> Table:
     trot = runs[runs["experiment"] == "trot"].copy()
     trot["step cycle [s]"] = trot["run_id"].map(_cycle)
     trot["outcome"] = trot["status"].where(~trot["ok"], "walks the whole run")
-    return trot.sort_values("step cycle [s]")[["step cycle [s]", "outcome"]].to_markdown(index=False)
+    return Table(trot.sort_values("step cycle [s]")[["step cycle [s]", "outcome"]])
 
 
-def _kinematics(frame: pd.DataFrame) -> str:
+def _kinematics(frame: pd.DataFrame) -> Section:
     def value(metric: str, scale: float = 1.0) -> float:
         return metric_value(frame, "ik-bezier", metric) * scale
 
@@ -143,12 +149,13 @@ def _kinematics(frame: pd.DataFrame) -> str:
             ("poses out of the printed form's reach (NaN)",
              f"{value('ik.printed.unreachable'):.0f} of {value('ik.workspace_samples'):.0f}", ""),
             ("Table 5 standing: foot below the hip [mm]", f"{value('table5.standing.depth', 1e3):.1f}", "≈ 205")]
-    table = pd.DataFrame(rows, columns=["quantity", "pipeline", "spec §3.3, §3.2, §10 (derived)"])
-    return ("## Kinematics (Secs. 3.1, 3.3)\n\nThe Bezier curve's shape against the values the spec derived (the "
-            "paper prints only the control points), and the IK round trips.\n\n" + table.to_markdown(index=False))
+    table = pd.DataFrame(rows, columns=["quantity", "pipeline", "derived by hand from Tables 3, 5 (not printed)"])
+    return Section("Kinematics (Secs. 3.1, 3.3)",
+                   "The Bezier curve's shape against values derived by hand from Table 3's control points (the paper "
+                   "prints only the control points), and the IK round trips.", Table(table), category="trajectories")
 
 
-def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]:
+def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]:
     sections = []
     if "trot" in metrics or "stand" in metrics:
         sections.append(_imu(metrics, runs))

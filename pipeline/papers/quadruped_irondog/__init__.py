@@ -13,7 +13,7 @@ The importable API (SI units; legs FR, FL, BR, BL; leg frame x lateral, y up, z 
 
 from __future__ import annotations
 
-from pipeline.core.experiment import OneOf, Range
+from pipeline.core.experiment import Budget, Length, OneOf, Range, Rule, Text
 from pipeline.papers.quadruped_irondog.gait import Trot, bezier, de_casteljau
 from pipeline.papers.quadruped_irondog.kinematics import Layout, Leg, body_ik, fk, ik
 from pipeline.papers.quadruped_irondog.model import Robot, Scene, mjcf
@@ -39,7 +39,7 @@ ANGLE_DEG = Range(ge=-180, le=180)
 SECONDS = Range(ge=0, le=60)
 TRUNK_PARTS = ("base", "head", "back_shell", "pitch_mounts", "coxa_servos", "battery", "other", "screws")
 
-LIMITS: dict[str, Range | OneOf] = {
+LIMITS = {
     **{f"system.leg.{k}": LENGTH for k in ("L1", "L2", "L3")},
     "system.leg.ik_form": OneOf(("corrected", "printed")),
     **{f"system.body.{k}": LENGTH for k in ("length", "hip_width", "height", "link_width", "link_thickness",
@@ -55,7 +55,7 @@ LIMITS: dict[str, Range | OneOf] = {
     "system.gait.control_points_mm": Range(ge=-1000, le=1000),
     "system.gait.cycle_time": Range(ge=0.1, le=5), "system.gait.duty_factor": Range(gt=0, lt=1),
     "system.gait.a_points": OneOf(("backward", "forward")), "system.gait.stride_scale": Range(ge=0, le=2),
-    "system.physics.timestep": Range(ge=1e-5, le=0.01), "system.physics.friction": Range(gt=0, le=5),
+    "system.physics.timestep": Range(ge=1e-4, le=0.01), "system.physics.friction": Range(gt=0, le=5),
     "system.control.rate_hz": Range(ge=1, le=1000),
     "system.balance.kp": Range(ge=0, le=10), "system.balance.ki": Range(ge=0, le=100),
     "system.balance.kd": Range(ge=0, le=10), "system.balance.limit_deg": Range(gt=0, le=45),
@@ -65,20 +65,44 @@ LIMITS: dict[str, Range | OneOf] = {
     "scenario.bezier_samples": Range(ge=2, le=100_000), "scenario.workspace_samples": Range(ge=1, le=1_000_000),
     "scenario.timing_calls": Range(ge=1, le=100_000),
     # stand, self-levelling
-    "scenario.duration": Range(gt=0, le=60), "scenario.payloads": Range(ge=0, le=50),
+    "scenario.duration": Range(gt=0, le=60), "scenario.payloads": (Length(1, 10), Range(ge=0, le=50)),
     "scenario.window": Range(gt=0, le=60),
     # body-poses
     "scenario.settle": Range(ge=0, le=10), "scenario.ramp": Range(gt=0, le=10), "scenario.hold": Range(gt=0, le=10),
     "scenario.translation": Range(ge=-0.1, le=0.1), "scenario.rotation_deg": Range(ge=-30, le=30),
     "scenario.reach": Range(gt=0, le=1),
     # self-levelling
-    "scenario.axes": OneOf(("pitch", "roll")), "scenario.tilt_deg": Range(ge=-30, le=30),
+    "scenario.axes": (Length(1, 2), OneOf(("pitch", "roll"))), "scenario.tilt_deg": Range(ge=-30, le=30),
     "scenario.tilt_start": SECONDS, "scenario.tilt_ramp": Range(gt=0, le=60),
     "scenario.level_band_deg": Range(gt=0, le=10),
     # trot
-    "scenario.cycle_times": Range(ge=0.1, le=5), "scenario.rise": Range(gt=0, le=10),
+    "scenario.cycle_times": (Length(1, 20), Range(ge=0.1, le=5)), "scenario.rise": Range(gt=0, le=10),
     "scenario.ramp_cycles": Range(gt=0, le=20), "scenario.cycles": Range(ge=1, le=200),
     "scenario.skip_cycles": Range(ge=0, le=100),
     # tables: the paper's numbers as printed
-    "scenario.text.gravity_m_s2": Range(gt=0, le=20),
+    "scenario.tables": Text(), "scenario.text.gravity_m_s2": Range(gt=0, le=20),
+}
+RULES = (
+    Rule(("system.physics.timestep", "system.control.rate_hz"), lambda dt, hz: dt <= 1 / hz,
+         "system.physics.timestep={0:g} s must not exceed the control period 1/system.control.rate_hz={1:g} Hz"),
+    Rule(("system.log.rate_hz", "system.physics.timestep"), lambda hz, dt: 1 / hz >= dt,
+         "system.log.rate_hz={0:g} Hz logs more often than the physics step system.physics.timestep={1:g} s"),
+    Rule(("scenario.window", "scenario.duration"), lambda window, duration: window <= duration,
+         "scenario.window={0:g} s is longer than the run (scenario.duration={1:g} s)"),
+)
+STEPS = "physics steps"
+FEWER = "a longer system.physics.timestep or a shorter run"
+BUDGETS = {
+    "kinematics": Budget("IK and Bezier evaluations", lambda c: c.scenario.bezier_samples * 3
+                         + c.scenario.workspace_samples * 3 + c.scenario.timing_calls * 3, 1e7,
+                         "fewer scenario.workspace_samples or scenario.timing_calls"),
+    "stand": Budget(STEPS, lambda c: len(c.scenario.payloads) * c.scenario.duration / c.system.physics.timestep,
+                    2e6, f"fewer scenario.payloads, {FEWER}"),
+    "body-poses": Budget(STEPS, lambda c: (2 * c.scenario.settle + 11 * (2 * c.scenario.ramp + c.scenario.hold))
+                         / c.system.physics.timestep, 2e6, FEWER),
+    "self-levelling": Budget(STEPS, lambda c: 2 * len(c.scenario.axes) * c.scenario.duration
+                             / c.system.physics.timestep, 2e6, f"fewer scenario.axes, {FEWER}"),
+    "trot": Budget(STEPS, lambda c: sum(c.scenario.settle + c.scenario.rise + c.scenario.cycles * t
+                                        for t in c.scenario.cycle_times) / c.system.physics.timestep, 2e6,
+                   f"fewer scenario.cycle_times or scenario.cycles, {FEWER}"),
 }
