@@ -62,7 +62,7 @@ def foot_constraints(mu: float, f_min: float, half_x: float, half_y: float) -> t
     b = np.zeros(FOOT_ROWS)
     A[0, 2], b[0] = -1.0, -f_min                       # f_z ≥ f_min
     for r, (i, s) in enumerate(((0, 1), (0, -1), (1, 1), (1, -1)), start=1):
-        A[r, i], A[r, 2] = s, -mu                      # |f_x|, |f_y| ≤ μ f_z (linearised cone)
+        A[r, i], A[r, 2] = s, -mu / np.sqrt(2)         # |f_x|, |f_y| ≤ μ f_z / √2: the pyramid inside the cone
     A[5, 4], A[5, 2] = -1.0, -half_x                   # CoP x = −τ_y / f_z ≤ d_x
     A[6, 4], A[6, 2] = 1.0, -half_x                    # CoP x ≥ −d_x
     A[7, 3], A[7, 2] = 1.0, -half_y                    # CoP y = τ_x / f_z ≤ d_y
@@ -142,6 +142,7 @@ class WalkingController:
         self.g = np.array([0.0, 0.0, -gravity])
         self.measured_ff = c["feedforward_com"] == "measured"
         self.clamp = bool(c["clamp_zmp"])
+        self.hold_stance = c["stance_foot"] == "hold"
         self.polygons = polygons
         gains = Gains.from_config(c)
         self.kp = {k: v for k, v in vars(gains).items()}
@@ -157,6 +158,7 @@ class WalkingController:
         self.J = np.zeros((18, nv))           # rows: CoM, base rotation, left foot (lin, rot), right foot
         self.J_prev = np.zeros((18, nv))
         self.first = True
+        self.anchor: list[np.ndarray | None] = [None, None]   # where each stance foot was planted
         self.model_seconds = 0.0
         self.M = np.zeros((nv, nv))
         self.G = np.zeros((6, 12))
@@ -232,14 +234,23 @@ class WalkingController:
         w_base = v[3:6]
         dw_base = kp["base"] * orientation_error(R) - kd["base"] * w_base
         swing = -1 if state == DOUBLE else (1 if state == LEFT else 0)
-        if swing >= 0:
-            site, r0 = self.sites[swing], 6 + 6 * swing
-            Rf = d.site_xmat[site]
-            e = np.concatenate([ref.feet[swing, i] - d.site_xpos[site], orientation_error(Rf)])
+        for f in (0, 1):                 # eq. (52) for both feet; a stance foot holds where it was planted
+            site, r0 = self.sites[f], 6 + 6 * f
+            if f != swing and not self.hold_stance:
+                continue                 # the stance foot's acceleration: zero
+            if f == swing:
+                self.anchor[f] = None
+                target = ref.feet[f, i]
+            elif self.anchor[f] is None:
+                target = self.anchor[f] = d.site_xpos[site].copy()
+            else:
+                target = self.anchor[f]
+            e = np.concatenate([target - d.site_xpos[site], orientation_error(d.site_xmat[site])])
             ev = -v[r0:r0 + 6]
-            ev[:3] += ref.feet_vel[swing, i]
+            if f == swing:
+                ev[:3] += ref.feet_vel[f, i]
+                rhs[r0:r0 + 3] += ref.feet_acc[f, i]
             rhs[r0:r0 + 6] += kp["foot"] * e + kd["foot"] * ev
-            rhs[r0:r0 + 3] += ref.feet_acc[swing, i]
         # eq. (53), with the weight
         inertia = self.inertia
         gyro = cross(w_base, inertia @ w_base)

@@ -32,9 +32,9 @@ Balance = schemas.define(
     "Per controller cycle: measured CoM (m), CoM velocity (m/s), capture point ξ = x_c + ẋ_c/ω (m), measured ZMP = "
     "CoP of all contact forces (m; z = 0 on the ground, NaN without contact), commanded ZMP p^c of eq. (50) after "
     "the clamp (m; z: the virtual eZMP height), support (0 both feet, 1 left, 2 right), DAQP exit flag of the "
-    "wrench QP (1 = optimal; NaN: no QP) and its iterations. `name` labels x, y, z.",
+    "wrench QP (1 = optimal; NaN: no QP) and its iterations, and the measured sole centres (m). `name` labels x, y, z.",
     name="string[]", com="double[]", com_vel="double[]", cp="double[]", zmp="double[]", zmp_cmd="double[]",
-    support="double", qp_flag="double", qp_iterations="double",
+    support="double", qp_flag="double", qp_iterations="double", left_sole="double[]", right_sole="double[]",
 )
 Curve = schemas.define(
     "ForrestCurve", "One sample of a curve over a joint angle or a grid of two (log time = sample index in ms): "
@@ -107,7 +107,7 @@ def log_walk(log: RunWriter, p: gen.Pattern, w: walking.WalkLog, biped, tf_every
     zmp = np.column_stack([w.zmp, np.where(np.isnan(w.zmp[:, 0]), np.nan, 0.0)])
     log.log_series("/balance", t, Balance, name=XYZ, com=w.com, com_vel=w.com_vel, cp=w.cp, zmp=zmp,
                    zmp_cmd=w.zmp_cmd, support=p.support[:n] * 1.0, qp_flag=w.qp_flag * 1.0,
-                   qp_iterations=w.qp_iterations * 1.0)
+                   qp_iterations=w.qp_iterations * 1.0, left_sole=w.feet[:, 0], right_sole=w.feet[:, 1])
     log_errors(log, t, p, w.com, w.cp)
     zerr = w.zmp_cmd[:, :2] - w.zmp
     log.log_series("/tracking_error/zmp", t, name=XYZ[:2], error=zerr, norm=np.linalg.norm(zerr, axis=1))
@@ -225,7 +225,8 @@ def _lipm_case(cfg: DictConfig, kind: str, lag: float):
         log_pattern(log, p)
         nan = np.full(len(r.t), np.nan)
         log.log_series("/balance", r.t, Balance, name=XYZ, com=r.com, com_vel=r.com_vel, cp=r.cp, zmp=r.zmp,
-                       zmp_cmd=r.zmp_cmd, support=p.support * 1.0, qp_flag=nan, qp_iterations=nan)
+                       zmp_cmd=r.zmp_cmd, support=p.support * 1.0, qp_flag=nan, qp_iterations=nan,
+                       left_sole=p.feet[0], right_sole=p.feet[1])
         log_errors(log, r.t, p, r.com, r.cp)
         if not np.isfinite(r.com).all():
             raise SimulationFailed("the LIP state went non-finite")

@@ -192,8 +192,7 @@ def walk(biped: Biped, control_model: Biped, pattern: Pattern, system: Mapping[s
                 fz = f[:, 2].sum()
                 if fz > 1e-6:
                     log.zmp[i] = f[:, 2] @ pos[:, :2] / fz
-        for _ in range(substeps - 1):
-            step(model, data)
+        step(model, data, substeps - 1)
         if not np.isfinite(data.qpos).all() or not np.isfinite(data.qvel).all():
             log.failure = f"state not finite at t = {pattern.t[i]:.3f} s"
         elif com[2] < fall_z:
