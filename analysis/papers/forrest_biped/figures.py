@@ -166,26 +166,31 @@ def walking_figures(runs: dict[str, Run], errors: dict[str, Walk], shares: dict[
     tf = ext["/tf"]
     bodies = [c.removeprefix("transforms.").removesuffix(".translation.x") for c in tf.columns
               if c.endswith(".translation.x")]
-    fig, (side, top) = plt.subplots(2, 1, figsize=(11, 6.5), gridspec_kw={"height_ratios": [1.4, 1]})
     times = np.arange(1.0, 3.01, 0.25)
+    fig = plt.figure(figsize=(12, 6.5))
+    grid = fig.add_gridspec(2, len(times), height_ratios=[1.3, 1])
     chains = [["base", "l_link7", "l_link9", "l_link10", "l_link11"], ["base", "r_link13", "r_link15", "r_link16",
                                                                        "r_link17"]]
     for k, t0 in enumerate(times):
+        side = fig.add_subplot(grid[0, k])
         row = tf.iloc[int(np.argmin(np.abs(tf.index.to_numpy() - t0)))]
         pos = {b: np.array([row[f"transforms.{b}.translation.{a}"] for a in XYZ]) for b in bodies}
-        shade = str(0.75 - 0.5 * k / len(times))
-        for chain, ls in zip(chains, ("-", "--"), strict=True):
+        for chain, color in zip(chains, ("tab:blue", "tab:orange"), strict=True):
             pts = np.array([pos[b] for b in chain if b in pos])
-            sole = pts[-1] - np.array([0, 0, 0.105])
-            pts = np.vstack([pts, sole])
-            side.plot(pts[:, 0], pts[:, 2], ls=ls, color=shade, lw=1.2)
-        side.plot([pos["base"][0], pos["base"][0]], [pos["base"][2], pos["base"][2] + 0.25], color=shade, lw=3)
+            pts = np.vstack([pts, pts[-1] - np.array([0, 0, 0.105])])        # down to the sole
+            side.plot(pts[:, 0], pts[:, 2], color=color, lw=1.5)
+        side.plot([pos["base"][0]] * 2, [pos["base"][2], pos["base"][2] + 0.25], color="0.4", lw=4)
         side.plot(pos["com"][0], pos["com"][2], "o", color="tab:red", ms=5)
         side.plot(pos["zmp"][0], 0.0, "o", color="tab:green", ms=5)
-    side.set_aspect("equal")
-    side.set_xlabel("x [m]")
-    side.set_ylabel("z [m]")
-    side.set_title("side view every 0.25 s from 1 s to 3 s (left leg solid), CoM red, CoP green", fontsize=8)
+        side.axhline(0, color="0.6", lw=0.8)
+        side.set_xlim(pos["com"][0] - 0.35, pos["com"][0] + 0.35)
+        side.set_ylim(-0.05, 1.2)
+        side.set_aspect("equal")
+        side.set_title(f"{t0:.2f} s", fontsize=8)
+        side.tick_params(labelsize=6)
+        if k:
+            side.set_yticklabels([])
+    top = fig.add_subplot(grid[1, :])
     bal = ext["/balance"]
     top.plot(bal["com.x"], bal["com.y"], color="tab:red", label="CoM")
     top.plot(bal["zmp.x"], bal["zmp.y"], color="tab:green", lw=0.8, label="CoP (measured)")
@@ -194,7 +199,8 @@ def walking_figures(runs: dict[str, Run], errors: dict[str, Walk], shares: dict[
     top.set_xlabel("x [m]")
     top.set_ylabel("y [m]")
     top.legend(fontsize=7, loc="upper left")
-    fig.suptitle("Fig. 18: the walk in MuJoCo (extended generator)")
+    fig.suptitle("Fig. 18: the walk in MuJoCo (extended generator), side views 1-3 s (left leg blue, right orange), "
+                 "CoM red, CoP green")
     figures.save(fig, "fig18-walk")
     # Fig. 19: CoM and CP, desired (red) against measured (blue)
     fig, axes = plt.subplots(2, 2, figsize=(10, 5.5), sharex=True)

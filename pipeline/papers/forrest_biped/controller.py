@@ -131,8 +131,9 @@ class WalkingController:
     def __init__(self, biped: Biped, c: Mapping[str, Any], omega: float, gravity: float, mu: float,
                  polygons: list):
         import mujoco
+        from scipy.linalg.lapack import dgesv
 
-        self.mj = mujoco
+        self.mj, self.gesv = mujoco, dgesv
         self.m = model = mujoco.MjModel.from_xml_string(biped.xml)
         self.d = mujoco.MjData(model)
         mass, foot_half, torque_limit = biped.mass, biped.foot_half, biped.torque_limit
@@ -260,22 +261,24 @@ class WalkingController:
         # eqs. (54)-(56)
         G = self.G
         xmat = d.site_xmat
+        self.Rs = xmat[self.sites].reshape(2, 3, 3)
         for f, site in enumerate(self.sites):
-            Rf = xmat[site].reshape(3, 3)
+            Rf = self.Rs[f]
             r = d.site_xpos[site] - com
             G[0:3, 6 * f:6 * f + 3] = Rf
             G[3:6, 6 * f + 3:6 * f + 6] = Rf
             G[3:6, 6 * f:6 * f + 3] = np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]]) @ Rf
         w_local, flag = self.qp.solve(G, F_d, state)
         F_opt = G @ w_local
-        wrench = np.concatenate([G[0:3, 0:3] @ w_local[0:3], G[0:3, 0:3] @ w_local[3:6],
-                                 G[0:3, 6:9] @ w_local[6:9], G[0:3, 6:9] @ w_local[9:12]])
+        # the foot wrenches in world axes: each foot's [f τ] turned by its sole rotation
+        wrench = (self.Rs[:, None] @ w_local.reshape(2, 2, 3, 1)).reshape(12)
         # the optimized CoM accelerations, then eq. (57): J q̈ = a − J̇q̇
         rhs[0:3] += F_opt[:3] / self.mass + self.g
         rhs[3:6] += self.inertia_inv @ (F_opt[3:] - gyro)
-        qacc = np.linalg.solve(J, rhs)
+        qacc = self.gesv(J, rhs)[2]      # LAPACK directly: np.linalg.solve's checks cost as much as the solve
         # eq. (58): τ = (M q̈ + h − J_lᵀ W_l − J_rᵀ W_r) on the actuated rows
         mj.mj_fullM(m, d, self.M)
         tau = (self.M[6:] @ qacc + d.qfrc_bias[6:] - wrench @ J[6:, 6:])
-        np.clip(tau, -self.limit, self.limit, out=tau)
+        np.minimum(tau, self.limit, out=tau)
+        np.maximum(tau, -self.limit, out=tau)
         return CycleOut(tau, p_c, wrench, F_d, F_opt, flag, self.qp.iterations)

@@ -21,8 +21,7 @@ from pipeline.papers.forrest_biped.generator import DOUBLE, LEFT, Pattern
 from pipeline.papers.forrest_biped.model import CORNERS, JOINTS, Biped
 
 XYZ = np.arange(3)
-ROLL1, ROLL2 = np.array([1, 2, 0]), np.array([2, 0, 1])
-ONE_HOT = np.eye(2)
+MAX_CONTACTS = 8        # the four corners of each plate; nothing else collides with the floor
 
 
 def support_polygons(pattern: Pattern, half: tuple[float, float], margin: float) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -112,6 +111,27 @@ class WalkLog:
         return WalkLog(**keep, tf_t=self.tf_t[:m], tf=self.tf[:m], failure=self.failure, warnings=self.warnings)
 
 
+def contact_wrenches(log: WalkLog, geom: np.ndarray, pos: np.ndarray, frame: np.ndarray, force: np.ndarray,
+                     corner_index: np.ndarray, floor: int) -> None:
+    """Per cycle from the raw contacts (n, MAX_CONTACTS, ·): the force at each plate corner (world), each foot's
+    wrench about its sole centre, and the measured ZMP (CoP of all contact forces)."""
+    valid = geom[..., 0] >= 0
+    foot_geom = np.where(geom[..., 0] == floor, geom[..., 1], geom[..., 0])
+    where = np.where(valid, corner_index[np.where(valid, foot_geom, 0)], -1)
+    hit = where >= 0
+    sign = np.where(geom[..., 0] == floor, 1.0, -1.0)                 # MuJoCo's force acts on geom2
+    f = np.einsum("cnji,cnj->cni", frame.reshape(*frame.shape[:2], 3, 3), force) * (sign * hit)[..., None]
+    cycle, slot = np.nonzero(hit)
+    foot, corner = np.divmod(where[cycle, slot], 4)
+    log.corner_force[cycle, foot, corner] = f[cycle, slot]
+    arm = pos[cycle, slot] - log.feet[cycle, foot]
+    fc = f[cycle, slot]
+    np.add.at(log.wrench, (cycle, foot), np.hstack([fc, np.cross(arm, fc)]))
+    fz = f[..., 2].sum(axis=1)
+    touching = fz > 1e-6
+    log.zmp[touching] = np.einsum("cn,cnk->ck", f[touching, :, 2], pos[touching, :, :2]) / fz[touching, None]
+
+
 def walk(biped: Biped, control_model: Biped, pattern: Pattern, system: Mapping[str, Any],
          tf_every: int = 10) -> WalkLog:
     """Run the walk of `pattern` on the simulated robot `biped` under the controller built on `control_model`;
@@ -142,12 +162,15 @@ def walk(biped: Biped, control_model: Biped, pattern: Pattern, system: Mapping[s
     log = WalkLog(
         t=pattern.t.copy(), q=np.empty((n, 12)), qd=np.empty((n, 12)), tau=np.empty((n, 12)), com=np.empty((n, 3)),
         com_vel=np.empty((n, 3)), cp=np.empty((n, 3)), zmp_cmd=np.empty((n, 3)), zmp=np.full((n, 2), np.nan),
-        feet=np.empty((n, 2, 3)), wrench_cmd=np.empty((n, 2, 6)), wrench=np.zeros((n, 2, 6)),
+        feet=np.empty((n, 2, 3)), wrench_cmd=np.empty((n, 12)), wrench=np.zeros((n, 2, 6)),
         corner_force=np.zeros((n, 2, 4, 3)), F_d=np.empty((n, 6)), F_opt=np.empty((n, 6)),
         qp_flag=np.empty(n, dtype=np.int64), qp_iterations=np.empty(n, dtype=np.int64), compute=np.empty((n, 3)),
-        tf_t=pattern.t[::tf_every].copy(), tf=np.empty((len(pattern.t[::tf_every]), len(bodies), 4, 4)))
-    fall_z, fall_tilt = float(c["fall_height"]), float(c["fall_tilt"])
+        tf_t=pattern.t[::tf_every].copy(), tf=np.tile(np.eye(4), (len(pattern.t[::tf_every]), len(bodies), 1, 1)))
+    fall_z, fall_tilt = float(c["fall_height"]), np.cos(float(c["fall_tilt"]))
     jac_com = np.zeros((3, model.nv))
+    # the contacts of each solve, raw (at most the eight corners touch the floor); wrenches are computed after
+    raw_geom, raw_pos = np.full((n, MAX_CONTACTS, 2), -1), np.zeros((n, MAX_CONTACTS, 3))
+    raw_frame, raw_force = np.zeros((n, MAX_CONTACTS, 9)), np.zeros((n, MAX_CONTACTS, 3))
     clock = time.perf_counter_ns
     step1, step2, step = mujoco.mj_step1, mujoco.mj_step2, mujoco.mj_step
     for i in range(n):
@@ -157,51 +180,40 @@ def walk(biped: Biped, control_model: Biped, pattern: Pattern, system: Mapping[s
         t2 = clock()
         data.ctrl[:] = out.tau
         log.compute[i] = (t2 - t1) * 1e-9, ctl.qp.seconds, ctl.model_seconds
-        # the measured state at t_i
+        # the measured state at t_i: the simulated robot's own CoM and soles (mj_step1 computed them)
         log.q[i], log.qd[i], log.tau[i] = data.qpos[7:], data.qvel[6:], out.tau
-        com = data.subtree_com[base]     # the simulated robot's own CoM (mj_step1 computed it at t_i)
+        com = log.com[i] = data.subtree_com[base]
         mujoco.mj_jacSubtreeCom(model, data, jac_com, base)
-        log.com[i], log.com_vel[i] = com, jac_com @ data.qvel
-        log.cp[i] = com + log.com_vel[i] / pattern.omega
-        log.zmp_cmd[i], log.F_d[i], log.F_opt[i] = out.zmp_cmd, out.F_d, out.F_opt
-        log.wrench_cmd[i] = out.wrench.reshape(2, 6)
+        log.com_vel[i] = jac_com @ data.qvel
+        log.zmp_cmd[i], log.F_d[i], log.F_opt[i], log.wrench_cmd[i] = out.zmp_cmd, out.F_d, out.F_opt, out.wrench
         log.qp_flag[i], log.qp_iterations[i] = out.qp_flag, out.qp_iterations
         log.feet[i] = data.site_xpos[sites]
         if i % tf_every == 0:
             pose = log.tf[i // tf_every]
-            pose[:] = np.eye(4)
             pose[:, :3, :3] = data.xmat[bodies].reshape(-1, 3, 3)
             pose[:, :3, 3] = data.xpos[bodies]
         step2(model, data)
-        if data.ncon:                # contact forces of the solve at t_i (elliptic cones: efc_force is the force)
+        k = data.ncon
+        if k:                        # the contacts of the solve at t_i (elliptic cones: efc_force is the force)
             contact = data.contact
-            geom = contact.geom
-            foot_geom = np.where(geom[:, 0] == floor, geom[:, 1], geom[:, 0])
-            where = corner_index[foot_geom]
-            hit = where >= 0
-            if hit.any():
-                sign = np.where(geom[hit, 0] == floor, 1.0, -1.0)      # the force acts on geom2
-                local = data.efc_force[contact.efc_address[hit, None] + XYZ]
-                f = np.einsum("nji,nj->ni", contact.frame[hit].reshape(-1, 3, 3), local) * sign[:, None]
-                pos = contact.pos[hit]
-                foot, k = divmod(where[hit], 4)
-                log.corner_force[i, foot, k] = f
-                arm = pos - log.feet[i, foot]
-                moment = arm[:, ROLL1] * f[:, ROLL2] - arm[:, ROLL2] * f[:, ROLL1]   # arm × f
-                log.wrench[i] = ONE_HOT[foot].T @ np.hstack([f, moment])
-                fz = f[:, 2].sum()
-                if fz > 1e-6:
-                    log.zmp[i] = f[:, 2] @ pos[:, :2] / fz
+            k = min(k, MAX_CONTACTS)
+            raw_geom[i, :k], raw_pos[i, :k], raw_frame[i, :k] = contact.geom[:k], contact.pos[:k], contact.frame[:k]
+            raw_force[i, :k] = data.efc_force[contact.efc_address[:k, None] + XYZ]
         step(model, data, substeps - 1)
-        if not np.isfinite(data.qpos).all() or not np.isfinite(data.qvel).all():
+        if not np.isfinite(data.qvel).all():
             log.failure = f"state not finite at t = {pattern.t[i]:.3f} s"
         elif com[2] < fall_z:
             log.failure = f"fell at t = {pattern.t[i]:.3f} s: CoM height {com[2]:.3f} m < {fall_z:g} m"
-        elif data.xmat[base, 8] < np.cos(fall_tilt):
-            log.failure = f"fell at t = {pattern.t[i]:.3f} s: base tilted more than {np.degrees(fall_tilt):.0f}°"
+        elif data.xmat[base, 8] < fall_tilt:
+            log.failure = (f"fell at t = {pattern.t[i]:.3f} s: base tilted more than "
+                           f"{np.degrees(np.arccos(fall_tilt)):.0f}°")
         if log.failure:
             log = log.cut(i + 1)
+            n = i + 1
             break
+    log.cp = log.com + log.com_vel / pattern.omega
+    log.wrench_cmd = log.wrench_cmd.reshape(n, 2, 6)
+    contact_wrenches(log, raw_geom[:n], raw_pos[:n], raw_frame[:n], raw_force[:n], corner_index, floor)
     log.warnings = {w.name: int(data.warning[int(w)].number) for w in
                     (mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADQVEL)
                     if data.warning[int(w)].number}
