@@ -76,7 +76,7 @@ def robustness_section(r: pd.DataFrame, w: pd.DataFrame | None) -> str:
         rows.append({"sweep job (overrides)": job,
                      "share x [%]": metric_value(r, job, "share.x.window") * 100,
                      "share y [%]": metric_value(r, job, "share.y.window") * 100,
-                     "max |CoM error| xy [mm]": metric_value(r, job, "com_error.max_xy") * 1e3,
+                     "max ‖CoM error‖ xy [mm]": metric_value(r, job, "com_error.max_xy") * 1e3,
                      "RMS difference x / y": f"{metric_value(r, job, 'rms_difference.x'):.2f} / "
                                              f"{metric_value(r, job, 'rms_difference.y'):.2f}",
                      "'not very significant'": bool(metric_value(r, job, "claim.not_significant"))})
