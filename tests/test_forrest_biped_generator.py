@@ -9,7 +9,7 @@ import yaml
 
 from pipeline.papers.forrest_biped import generator as gen
 from pipeline.papers.forrest_biped import lipm
-from pipeline.papers.forrest_biped.walking import support_polygons
+from pipeline.papers.forrest_biped.support import support_polygons
 
 from .conftest import ROOT
 

@@ -158,3 +158,22 @@ def test_a_walk_that_falls_is_a_failed_run_with_its_reason():
 
     with pytest.raises(SimulationFailed, match="fell at t = "):
         ex._walk_case(cfg, "extended")(Sink())
+
+
+def test_inverse_dynamics_terms_match_mujocos_inverse():
+    """Eq. (58)'s M q̈ + h (the controller's mj_fullM + qfrc_bias) equals MuJoCo's own inverse dynamics."""
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_string(build(SYSTEM, plant=False).xml)
+    data = mujoco.MjData(model)
+    rng = np.random.default_rng(7)
+    data.qpos[7:] = rng.uniform(-0.4, 0.4, 12)
+    data.qvel[:] = rng.normal(0, 0.5, 18)
+    data.qacc[:] = rng.normal(0, 2.0, 18)
+    mujoco.mj_fwdPosition(model, data)
+    mujoco.mj_fwdVelocity(model, data)
+    M = np.zeros((18, 18))
+    mujoco.mj_fullM(model, data, M)
+    ours = M @ data.qacc + data.qfrc_bias
+    mujoco.mj_inverse(model, data)
+    assert np.allclose(ours, data.qfrc_inverse, atol=1e-9)

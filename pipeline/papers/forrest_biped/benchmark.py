@@ -14,6 +14,7 @@ from pipeline.core.timing import best_of, time_calls
 from pipeline.papers.forrest_biped import experiments as ex
 from pipeline.papers.forrest_biped import lipm, walking
 from pipeline.papers.forrest_biped.model import build
+from pipeline.papers.forrest_biped.support import support_polygons
 
 
 def benchmark() -> list[dict]:
@@ -76,7 +77,7 @@ def benchmark() -> list[dict]:
         s = time_calls(kind, lambda k=kind: ex.make_pattern(cfg, k), [()], warmup=2, repeats=20).summary_us()
         rows.append({"what": f"{kind} generator, 4 s at 1 ms", "measure": "per call, median (p95)",
                      "value": s["median_us"] / 1e3, "p95": s["p95_us"] / 1e3, "unit": "ms"})
-    polygons = walking.support_polygons(pattern, biped.foot_half, cfg.system.controller.polygon_margin)
+    polygons = support_polygons(pattern, biped.foot_half, cfg.system.controller.polygon_margin)
     s = time_calls("lipm", lambda: lipm.simulate(pattern, cfg.system.controller.cp_gain, polygons, 1e-3), [()],
                    warmup=1, repeats=10).summary_us()
     rows.append({"what": "LIP closed loop, 4 s at 1 ms", "measure": "per run, median (p95)",

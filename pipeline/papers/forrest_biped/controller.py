@@ -29,6 +29,7 @@ import numpy as np
 
 from pipeline.papers.forrest_biped.generator import DOUBLE, LEFT, RIGHT
 from pipeline.papers.forrest_biped.model import Biped
+from pipeline.papers.forrest_biped.support import clamp
 
 INF = 1e30
 FOOT_ROWS = 11          # f_z ≥ f_min, friction pyramid (4), CoP (4), yaw moment (2)
@@ -165,6 +166,7 @@ class WalkingController:
         self.G = np.zeros((6, 12))
         self.rhs = np.zeros(18)
         self.F_d = np.zeros(6)
+        self.Rs = np.zeros((2, 3, 3))        # the sole rotations of the current cycle
         self.inertia = np.eye(3)
         self.inertia_inv = np.eye(3)
 
@@ -185,18 +187,6 @@ class WalkingController:
             r = d.xipos[b] - com
             inertia += R @ np.diag(m.body_inertia[b]) @ R.T + m.body_mass[b] * (r @ r * np.eye(3) - np.outer(r, r))
         return inertia
-
-    def clamp_zmp(self, p: np.ndarray, i: int) -> np.ndarray:
-        """p^c projected into the support polygon at cycle i (x, y; z untouched)."""
-        A, b = self.polygons[i]
-        q = p[:2].copy()
-        for _ in range(4):               # project onto the most violated edge, in turn (convex: a vertex in ≤ 2)
-            out = A @ q - b
-            j = int(out.argmax())
-            if out[j] <= 1e-12:
-                break
-            q -= out[j] * A[j]
-        return np.array([q[0], q[1], p[2]])
 
     def cycle(self, qpos: np.ndarray, qvel: np.ndarray, ref, i: int, state: int) -> CycleOut:
         """The torques for the measured state (qpos, qvel) at cycle i of the pattern `ref`."""
@@ -227,7 +217,7 @@ class WalkingController:
         if self.clamp:
             A, b = self.polygons[i]
             if (A @ p_c[:2] > b).any():
-                p_c = self.clamp_zmp(p_c, i)
+                p_c[:2] = clamp(p_c[:2], self.polygons[i])
         a_com = (self.omega**2 * ((com if self.measured_ff else ref.com[i]) - p_c)
                  + kp["com"] * (ref.com[i] - com) + kd["com"] * (ref.com_vel[i] - com_vel))
         # eq. (52): base orientation (upright), swing foot; a stance foot: zero acceleration

@@ -24,6 +24,7 @@ from pipeline.core.runlog import RunWriter, SimulationFailed
 from pipeline.papers.forrest_biped import generator as gen
 from pipeline.papers.forrest_biped import lipm, mechanisms, walking
 from pipeline.papers.forrest_biped.model import CORNERS, JOINTS, build
+from pipeline.papers.forrest_biped.support import support_polygons
 
 XYZ = ["x", "y", "z"]
 
@@ -219,7 +220,7 @@ def _lipm_case(cfg: DictConfig, kind: str, lag: float):
     def simulate(log: RunWriter) -> None:
         p = make_pattern(cfg, kind)
         biped = build(system_dict(cfg), plant=False)
-        polygons = (walking.support_polygons(p, biped.foot_half, cfg.system.controller.polygon_margin)
+        polygons = (support_polygons(p, biped.foot_half, cfg.system.controller.polygon_margin)
                     if cfg.system.controller.clamp_zmp else None)
         r = lipm.simulate(p, cfg.system.controller.cp_gain, polygons, cfg.system.controller.dt, lag)
         log_pattern(log, p)

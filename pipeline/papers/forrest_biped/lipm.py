@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pipeline.papers.forrest_biped.generator import Pattern
+from pipeline.papers.forrest_biped.support import clamp
 
 
 @dataclass(frozen=True)
@@ -24,18 +25,6 @@ class LipmLog:
     cp: np.ndarray        # (n, 3)
     zmp_cmd: np.ndarray   # (n, 3) p^c after the clamp
     zmp: np.ndarray       # (n, 3) the realised ZMP driving the LIP
-
-
-def clamp(p: np.ndarray, A: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Project p (x, y) into the convex polygon A p ≤ b (edge by edge, most violated first)."""
-    q = p.copy()
-    for _ in range(4):
-        out = A @ q - b
-        j = int(out.argmax())
-        if out[j] <= 1e-12:
-            break
-        q -= out[j] * A[j]
-    return q
 
 
 def simulate(pattern: Pattern, cp_gain: float, polygons: list | None, dt: float, zmp_lag: float = 0.0,
@@ -57,7 +46,7 @@ def simulate(pattern: Pattern, cp_gain: float, polygons: list | None, dt: float,
         xi = x + v / omega
         p_c = pattern.zmp[i] + gain * (xi - pattern.cp[i])                 # eq. (50)
         if polygons is not None:
-            p_c[:2] = clamp(p_c[:2], *polygons[i])
+            p_c[:2] = clamp(p_c[:2], polygons[i])
         cmd[i] = p_c
         p = lag * p + (1 - lag) * p_c        # the realised ZMP, held over the cycle
         real[i] = p

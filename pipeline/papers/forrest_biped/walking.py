@@ -17,31 +17,12 @@ from typing import Any
 import numpy as np
 
 from pipeline.papers.forrest_biped.controller import WalkingController, orientation_error
-from pipeline.papers.forrest_biped.generator import DOUBLE, LEFT, Pattern
+from pipeline.papers.forrest_biped.generator import Pattern
 from pipeline.papers.forrest_biped.model import CORNERS, JOINTS, Biped
+from pipeline.papers.forrest_biped.support import support_polygons
 
 XYZ = np.arange(3)
 MAX_CONTACTS = 8        # the four corners of each plate; nothing else collides with the floor
-
-
-def support_polygons(pattern: Pattern, half: tuple[float, float], margin: float) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Half-planes (A, b) with A p ≤ b of the support polygon at every cycle: the stance foot's plate, or the
-    convex hull of both plates in double support, `margin` inside; from the planned footholds."""
-    from scipy.spatial import ConvexHull
-
-    hx, hy = half[0] - margin, half[1] - margin
-    box = np.array([[hx, hy], [hx, -hy], [-hx, hy], [-hx, -hy]])
-    cache: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
-    out = []
-    for i, state in enumerate(pattern.support):
-        feet = [f for f in (0, 1) if state == DOUBLE or (state == LEFT) == (f == 0)]
-        key = (int(state), *(tuple(np.round(pattern.feet[f, i, :2], 9)) for f in feet))
-        if key not in cache:
-            points = np.vstack([pattern.feet[f, i, :2] + box for f in feet])
-            eq = ConvexHull(points).equations
-            cache[key] = (eq[:, :2], -eq[:, 2])
-        out.append(cache[key])
-    return out
 
 
 def standing_pose(model, data, com: np.ndarray, soles: np.ndarray, iterations: int = 50) -> np.ndarray:
