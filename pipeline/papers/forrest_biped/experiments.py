@@ -10,7 +10,8 @@ Topics of a walking run (every 1 ms controller cycle unless said):
     /wrench/com                      desired (eq. 53) and optimized (eq. 56) CoM wrench
     /wrench/contacts                 the force at each plate corner (N)
     /compute_time                    per cycle: the controller, its QP, its model update (s)
-    /tf, /markers                    body frames, CoM/CP/ZMP frames and spheres (at `scenario.tf_rate_hz`)
+    /tf, /markers                    body frames and the robot's geoms, CoM/CP/ZMP frames and spheres (/tf at
+                                     `scenario.tf_rate_hz`)
 """
 
 from __future__ import annotations
@@ -136,8 +137,12 @@ def log_walk(log: RunWriter, p: gen.Pattern, w: walking.WalkLog, biped, tf_every
     points[:, 0, :3, 3], points[:, 1, :3, 3] = w.com[rows], w.cp[rows]
     points[:, 2, :3, 3] = np.nan_to_num(zmp[rows])
     log.log_transforms(w.tf_t, "world", [*biped.body_names, "com", "cp", "zmp"], np.concatenate([w.tf, points], 1))
-    log.write("/markers", 0, schemas.SceneUpdate(entities=markers.spheres(
-        ["com", "cp", "zmp"], [0.03, 0.02, 0.02], [(0.9, 0.1, 0.1, 1), (0.1, 0.3, 0.9, 1), (0.1, 0.7, 0.2, 1)])))
+    import mujoco
+
+    robot = markers.mujoco_bodies(mujoco.MjModel.from_xml_string(biped.xml), biped.body_names)
+    points = markers.spheres(["com", "cp", "zmp"], [0.03, 0.02, 0.02],
+                             [(0.9, 0.1, 0.1, 1), (0.1, 0.3, 0.9, 1), (0.1, 0.7, 0.2, 1)])
+    log.write("/markers", 0, schemas.SceneUpdate(entities=[*robot, *points]))
 
 
 # -- experiments -------------------------------------------------------------------------------------------
