@@ -177,3 +177,19 @@ def test_inverse_dynamics_terms_match_mujocos_inverse():
     ours = M @ data.qacc + data.qfrc_bias
     mujoco.mj_inverse(model, data)
     assert np.allclose(ours, data.qfrc_inverse, atol=1e-9)
+
+
+def test_markers_draw_every_body_with_its_geoms():
+    import mujoco
+
+    from pipeline.core.markers import mujoco_bodies
+
+    biped = build(SYSTEM)
+    model = mujoco.MjModel.from_xml_string(biped.xml)
+    entities = {e.frame_id: e for e in mujoco_bodies(model, biped.body_names)}
+    assert set(entities) == set(biped.body_names)
+    thigh = entities["l_link9"]                                  # one capsule: a cylinder and two end spheres
+    assert len(thigh.cylinders) == 1 and len(thigh.spheres) == 2
+    assert thigh.cylinders[0].size.z == pytest.approx(0.405)
+    foot = entities["r_link18"]                                  # plate (box as triangles), four corner spheres
+    assert len(foot.triangles) == 1 and len(foot.triangles[0].indices) == 36
