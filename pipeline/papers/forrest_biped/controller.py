@@ -124,10 +124,12 @@ class CycleOut:
 
 
 class WalkingController:
-    """Sec. 6 on MuJoCo quantities. `cycle(ref, i, state)` reads `data` (after mj_step1) and returns the torques.
+    """Sec. 6 on the controller's own MuJoCo model: `cycle(qpos, qvel, ref, i, state)` returns the joint torques
+    for the measured state at cycle i of the pattern `ref`.
 
     The cycle is written for speed (about 60 NumPy calls): preallocated matrices filled in place, 3-vector algebra
-    by hand, the ZMP clamp only when p^c leaves the polygon."""
+    by hand, LAPACK called directly, the QP's constraint matrix and bounds built once per support state, the ZMP
+    clamp only when p^c leaves the polygon."""
 
     def __init__(self, biped: Biped, c: Mapping[str, Any], omega: float, gravity: float, mu: float,
                  polygons: list):
@@ -147,7 +149,7 @@ class WalkingController:
         self.hold_stance = c["stance_foot"] == "hold"
         self.polygons = polygons
         gains = Gains.from_config(c)
-        self.kp = {k: v for k, v in vars(gains).items()}
+        self.kp = dict(vars(gains))
         self.kd = {k: 2 * np.sqrt(v) for k, v in vars(gains).items()}
         margin = float(c["polygon_margin"])
         self.qp = WrenchQP(mu, float(c["min_normal_force"]), foot_half[0] - margin, foot_half[1] - margin,
