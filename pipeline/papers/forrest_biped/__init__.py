@@ -42,7 +42,8 @@ LIMITS: dict[str, Range | OneOf] = {
     _M + "torque_limit": POSITIVE, _M + "speed_limit_rpm": POSITIVE,
     _W + "step_length": Range(ge=0, le=0.5), _W + "step_time": Range(ge=0.5, le=5), _W + "steps": Range(ge=0, le=10),
     _W + "foot_spacing": Range(ge=0.1, le=0.5), _W + "z_init": Range(ge=0.5, le=0.77),
-    _W + "z_c": Range(ge=0.5, le=0.77), _W + "T1": Range(gt=0, le=0.2), _W + "T3": Range(gt=0, le=0.2),   # T1 + T3 < step_time
+    _W + "z_c": Range(ge=0.5, le=0.77),
+    _W + "T1": Range(gt=0, le=0.2), _W + "T3": Range(gt=0, le=0.2),      # so that T1 + T3 < step_time
     _W + "swing_height": Range(ge=0, le=0.2), _W + "duration": Range(gt=0, le=20),
     _W + "eq48": OneOf(("corrected", "printed")),
     _C + "dt": Range(ge=1e-4, le=0.01), _C + "cp_gain": Range(ge=0, le=100),
