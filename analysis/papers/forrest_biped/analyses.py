@@ -69,7 +69,7 @@ def analyze_robustness(runs: list[Run], figures: Figures) -> pd.DataFrame:
             m.add("band", f"share.{axis}.max", table[f"share.{axis}"].max(), "fraction")
         m.add("band", "jobs", len(table), "count")
         m.add("band", "claim.not_significant.holds", table["not_significant"].sum(), "count")
-        fig.robustness_figure(table, {}, figures)
+        fig.robustness_figure(table, figures)
     return m.frame()
 
 
