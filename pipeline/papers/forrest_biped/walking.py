@@ -1,10 +1,10 @@
 """The walking run in MuJoCo: FORREST of Table 4 on four corner contacts per foot, the Sec. 6 controller every
 1 ms on a 0.1 ms simulation (Sec. 6.3), following one generator's pattern.
 
-Per cycle: `mj_step1` (kinematics, mass matrix, bias forces, contacts at t_i), the controller, `mj_step2` (the
-constraint solve at t_i: the measured contact forces belong to t_i), then the remaining physics steps of the
-cycle. A fall (CoM too low, base tilted, non-finite state) ends the walk early; the caller logs what was
-recorded and marks the run failed with the reason.
+Per cycle: `mj_step1` (the simulated robot's kinematics and contacts at t_i: its CoM and soles for the log), the
+controller on its own model at the measured joint state, `mj_step2` (the constraint solve at t_i: the measured
+contact forces belong to t_i), then the remaining physics steps of the cycle. A fall (CoM too low, base tilted,
+non-finite state) ends the walk early; the caller logs what was recorded and marks the run failed with the reason.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from pipeline.core.runlog import SimulationFailed
 from pipeline.papers.forrest_biped.controller import WalkingController, orientation_error
 from pipeline.papers.forrest_biped.generator import Pattern
 from pipeline.papers.forrest_biped.model import CORNERS, JOINTS, Biped
@@ -50,12 +51,13 @@ def standing_pose(model, data, com: np.ndarray, soles: np.ndarray, iterations: i
             mujoco.mj_jacSite(model, data, J[3 + 6 * k:6 + 6 * k], J[6 + 6 * k:9 + 6 * k], site)
         e = np.concatenate(err)
         if np.abs(e).max() < 1e-12:
-            break
+            return q
         dq = np.linalg.lstsq(J[:, cols], e, rcond=None)[0]
         step = np.zeros(model.nv)
         step[cols] = dq
         mujoco.mj_integratePos(model, q, step, 1.0)
-    return q
+    raise SimulationFailed(f"no standing pose with the CoM at {np.round(com, 3).tolist()} m over soles "
+                           f"{np.round(soles, 3).tolist()} (residual {np.abs(e).max():.2g} m): legs too short?")
 
 
 @dataclass
