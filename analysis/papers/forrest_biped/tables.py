@@ -115,10 +115,11 @@ def mechanisms_section(m: pd.DataFrame) -> str:
          f"{metric_value(m, run, 'ankle.zero_pose.stiffness_q11'):.0f} / "
          f"{metric_value(m, run, 'ankle.zero_pose.stiffness_q12'):.0f}", "–"),
     ]
-    table = pd.DataFrame(rows, columns=["quantity", "pipeline", "paper"])
+    table = pd.DataFrame([(q, v if isinstance(v, str) else f"{v:.4g}", paper) for q, v, paper in rows],
+                         columns=["quantity", "pipeline", "paper"])
     return ("## Knee and ankle drives (Secs. 3-4)\n\nFrom the printed geometry and springs; motor torque and speed, "
             "drum radii and slider limits are not given (assumptions in paper.yaml).\n\n"
-            + table.to_markdown(index=False, floatfmt=".4g"))
+            + table.to_markdown(index=False))
 
 
 def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]:
