@@ -124,3 +124,58 @@ def _z_axis(quat_wxyz: Sequence[float]) -> np.ndarray:
     """The local z axis of a unit quaternion's frame."""
     w, x, y, z = quat_wxyz
     return np.array([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
+def _pose(position, quat_wxyz) -> schemas.Pose:
+    w, x, y, z = (float(v) for v in quat_wxyz)
+    return schemas.Pose(position=schemas.Vector3(x=float(position[0]), y=float(position[1]), z=float(position[2])),
+                        orientation=schemas.Quaternion(w=w, x=x, y=y, z=z))
+
+
+def _box(position, rotation, half, color) -> schemas.TriangleListPrimitive:
+    """A box as 12 triangles (Foxglove and Rerun both draw triangle lists)."""
+    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half
+    points = corners @ rotation.T + position
+    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1), (2, 3, 7), (2, 7, 6), (0, 2, 6),
+             (0, 6, 4), (1, 5, 7), (1, 7, 3)]
+    return schemas.TriangleListPrimitive(
+        pose=schemas.Pose(orientation=schemas.Quaternion(w=1.0)), color=_color(color),
+        points=[schemas.Point3(x=a, y=b, z=c) for a, b, c in points.tolist()],
+        indices=[i for face in faces for i in face])
+
+
+def mujoco_bodies(model, bodies: Sequence[str]) -> list:
+    """The geoms (spheres, capsules, cylinders, boxes) of the named MuJoCo bodies, one entity per body in the
+    /tf frame of the same name, so a run draws the simulated robot as MuJoCo sees it."""
+    import mujoco
+
+    sphere, capsule, cylinder, box = (int(t) for t in (mujoco.mjtGeom.mjGEOM_SPHERE, mujoco.mjtGeom.mjGEOM_CAPSULE,
+                                                        mujoco.mjtGeom.mjGEOM_CYLINDER, mujoco.mjtGeom.mjGEOM_BOX))
+    entities = []
+    for name in bodies:
+        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
+        spheres, cylinders, boxes = [], [], []
+        for g in np.flatnonzero(model.geom_bodyid == body):
+            kind, size, pos, quat = int(model.geom_type[g]), model.geom_size[g], model.geom_pos[g], model.geom_quat[g]
+            color = model.geom_rgba[g]
+            if kind == sphere:
+                d = 2 * size[0]
+                spheres.append(schemas.SpherePrimitive(pose=_pose(pos, quat), size=schemas.Vector3(x=d, y=d, z=d),
+                                                       color=_color(color)))
+            elif kind in (capsule, cylinder):
+                d, length = 2 * size[0], 2 * size[1]
+                cylinders.append(schemas.CylinderPrimitive(pose=_pose(pos, quat), bottom_scale=1.0, top_scale=1.0,
+                                                           size=schemas.Vector3(x=d, y=d, z=length),
+                                                           color=_color(color)))
+                if kind == capsule:
+                    rotation = np.zeros(9)
+                    mujoco.mju_quat2Mat(rotation, quat)
+                    axis = rotation.reshape(3, 3)[:, 2] * size[1]
+                    spheres += [schemas.SpherePrimitive(pose=_pose(pos + s * axis, quat),
+                                                        size=schemas.Vector3(x=d, y=d, z=d), color=_color(color))
+                                for s in (-1, 1)]
+            elif kind == box:
+                rotation = np.zeros(9)
+                mujoco.mju_quat2Mat(rotation, quat)
+                boxes.append(_box(pos, rotation.reshape(3, 3), size, color))
+        entities.append(schemas.SceneEntity(frame_id=name, id=f"{name}/geoms", frame_locked=True, spheres=spheres,
+                                            cylinders=cylinders, triangles=boxes))
+    return entities
