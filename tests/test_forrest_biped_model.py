@@ -182,14 +182,15 @@ def test_inverse_dynamics_terms_match_mujocos_inverse():
 def test_markers_draw_every_body_with_its_geoms():
     import mujoco
 
-    from pipeline.core.markers import mujoco_bodies
+    from pipeline.core.markers import mujoco_geoms
 
     biped = build(SYSTEM)
     model = mujoco.MjModel.from_xml_string(biped.xml)
-    entities = {e.frame_id: e for e in mujoco_bodies(model, biped.body_names)}
+    entities = {e.frame_id: e for e in mujoco_geoms(model, biped.body_names)}
     assert set(entities) == set(biped.body_names)
     thigh = entities["l_link9"]                                  # one capsule: a cylinder and two end spheres
     assert len(thigh.cylinders) == 1 and len(thigh.spheres) == 2
     assert thigh.cylinders[0].size.z == pytest.approx(0.405)
-    foot = entities["r_link18"]                                  # plate (box as triangles), four corner spheres
-    assert len(foot.triangles) == 1 and len(foot.triangles[0].indices) == 36
+    foot = entities["r_link18"]                                  # plate (a box: a cube), four corner spheres
+    corners = [s for s in foot.spheres if s.size.x == pytest.approx(2 * SYSTEM["model"]["corner_radius"])]
+    assert len(foot.cubes) == 1 and len(corners) == 4

@@ -5,7 +5,8 @@ Topics of a walking run (every 1 ms controller cycle unless said):
     /joint_state, /command           the 12 joints (rad, rad/s) and torques (N m, the applied = commanded)
     /reference/com, /cp, /zmp, /feet the generator's references (m, m/s, m/s²)
     /balance                         measured CoM, CP, ZMP and the commanded ZMP p^c (schema ForrestBalance)
-    /tracking_error, /cp, /zmp       CoM, CP error (reference − measured), ZMP error (p^c − measured CoP), m
+    /tracking_error, /cp, /zmp       CoM, CP error (reference − measured), ZMP error (p^c − measured CoP, at the
+                                     samples in contact), m
     /wrench/left_foot, /right_foot   measured (from the four corner contacts) and QP-commanded foot wrench
     /wrench/com                      desired (eq. 53) and optimized (eq. 56) CoM wrench
     /wrench/contacts                 the force at each plate corner (N)
@@ -111,8 +112,11 @@ def log_walk(log: RunWriter, p: gen.Pattern, w: walking.WalkLog, biped, tf_every
                    zmp_cmd=w.zmp_cmd, support=p.support[:n] * 1.0, qp_flag=w.qp_flag * 1.0,
                    qp_iterations=w.qp_iterations * 1.0, left_sole=w.feet[:, 0], right_sole=w.feet[:, 1])
     log_errors(log, t, p, w.com, w.cp)
-    zerr = w.zmp_cmd[:, :2] - w.zmp
-    log.log_series("/tracking_error/zmp", t, name=XYZ[:2], error=zerr, norm=np.linalg.norm(zerr, axis=1))
+    # the measured ZMP exists only in contact: its error is logged at those samples (a NaN there would read as a
+    # diverged state to the watchdog)
+    contact = np.isfinite(w.zmp[:, 0])
+    zerr = w.zmp_cmd[contact, :2] - w.zmp[contact]
+    log.log_series("/tracking_error/zmp", t[contact], name=XYZ[:2], error=zerr, norm=np.linalg.norm(zerr, axis=1))
     both = ["measured", "commanded"]
     for f, side in enumerate(("left_foot", "right_foot")):
         pair = np.stack([w.wrench[:, f], w.wrench_cmd[:, f]], axis=1)         # (n, 2, 6)
@@ -139,7 +143,7 @@ def log_walk(log: RunWriter, p: gen.Pattern, w: walking.WalkLog, biped, tf_every
     log.log_transforms(w.tf_t, "world", [*biped.body_names, "com", "cp", "zmp"], np.concatenate([w.tf, points], 1))
     import mujoco
 
-    robot = markers.mujoco_bodies(mujoco.MjModel.from_xml_string(biped.xml), biped.body_names)
+    robot = markers.mujoco_geoms(mujoco.MjModel.from_xml_string(biped.xml), biped.body_names)
     points = markers.spheres(["com", "cp", "zmp"], [0.03, 0.02, 0.02],
                              [(0.9, 0.1, 0.1, 1), (0.1, 0.3, 0.9, 1), (0.1, 0.7, 0.2, 1)])
     log.write("/markers", 0, schemas.SceneUpdate(entities=[*robot, *points]))
@@ -206,9 +210,12 @@ def pattern_generator(cfg: DictConfig) -> list[Case]:
     return [Case(name, case(kind, eq48)) for name, kind, eq48 in variants]
 
 
-def _walk_case(cfg: DictConfig, kind: str):
+def _walk_case(cfg: DictConfig, kind: str, stance_foot: str | None = None):
+    """The MuJoCo walk of generator `kind` (under another `system.controller.stance_foot` if given)."""
     def simulate(log: RunWriter) -> None:
         system = system_dict(cfg)
+        if stance_foot is not None:
+            system["controller"]["stance_foot"] = stance_foot
         biped, control = build(system), build(system, plant=False)
         log.attach("model.xml", biped.xml, "application/xml")
         log.attach("control_model.xml", control.xml, "application/xml")
@@ -240,9 +247,13 @@ def _lipm_case(cfg: DictConfig, kind: str, lag: float):
 
 
 def walking_runs(cfg: DictConfig) -> list[Case]:
-    """Figs. 18-20: each generator walking in MuJoCo, and the LIP closed loop for each ZMP lag."""
+    """Figs. 18-20: each generator walking in MuJoCo, again under each setting of `scenario.stance_foot_also`
+    (cases `stance-<setting>-<generator>`: the Eq. (59) shares under another stance-foot control), and the LIP
+    closed loop for each ZMP lag."""
     sc = cfg.scenario
     cases = [Case(kind, _walk_case(cfg, kind)) for kind in sc.generators]
+    cases += [Case(f"stance-{setting}-{kind}", _walk_case(cfg, kind, setting))
+              for setting in sc.stance_foot_also for kind in sc.generators]
     for lag in sc.lipm_zmp_lags:
         suffix = "" if lag == 0 else f"-lag{lag * 1e3:g}ms"
         cases += [Case(f"lipm{suffix}-{kind}", _lipm_case(cfg, kind, lag)) for kind in sc.generators]
