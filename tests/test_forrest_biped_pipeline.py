@@ -20,7 +20,8 @@ def test_short_walk_end_to_end(data_dir):
     sim = run_cli("pipeline", *SHORT, f"data_dir={data_dir}")
     assert sim.returncode == 0, sim.stderr[-2000:]
     runs = {r.run_id.partition("__")[0]: r for r in read_runs(data_dir / "runs/forrest-biped/walking")}
-    assert set(runs) == {"extended", "traditional", "lipm-extended", "lipm-traditional"}
+    assert set(runs) == {"extended", "traditional", "lipm-extended", "lipm-traditional", "stance-zero-extended",
+                         "stance-zero-traditional"}
     assert all(r.ok for r in runs.values())
     walk = runs["extended"]
     assert {"/joint_state", "/command", "/tf", "/compute_time", "/wrench/left_foot", "/wrench/right_foot",
@@ -43,13 +44,18 @@ def test_short_walk_end_to_end(data_dir):
     metrics = pd.read_parquet(data_dir / "metrics/forrest-biped/walking.parquet")
     shares = metrics[metrics["run_id"].str.startswith("all__") & metrics["metric"].str.match(r"share\.[xy]\.window")]
     assert len(shares) == 2 and shares["value"].between(0, 1).all()
+    # the shares under the other stance-foot setting, and its walks' slip, sit beside the default's
+    zero = metrics[metrics["run_id"].str.startswith("all__") & metrics["metric"].str.match(r"stance-zero\.share\.")]
+    assert len(zero) == 6 and zero["value"].between(0, 1).all()
+    assert metrics["run_id"].str.startswith("stance-zero-extended").any()
     assert (data_dir / "figures/forrest-biped/walking/fig20-com-error.png").exists()
     page = (data_dir / "report/forrest-biped.md").read_text()
     assert "share.x" in page and "Eq. (59)" in page
 
 
 @pytest.mark.parametrize("override, key", [("system.walk.duration=1e9", "system.walk.duration"),
-                                           ("system.walk.eq48=typo", "system.walk.eq48")])
+                                           ("system.walk.eq48=typo", "system.walk.eq48"),
+                                           ("scenario.window=[1.0]", "scenario.window")])
 def test_bad_input_is_refused_in_one_line(data_dir, override, key):
     proc = run_cli("pipeline", "experiment=forrest-biped/walking", override, f"data_dir={data_dir}")
     assert proc.returncode == 2

@@ -6,13 +6,14 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from analysis.core.figures import Figures, plt
+from analysis.core.figures import Figures, paper_hline, paper_vline, plt
+from analysis.core.targets import paper_value
 from analysis.papers.forrest_biped.metrics import XYZ, Walk, curve
 from pipeline.core.runlog import Run
 
 DESIRED, MEASURED = "tab:red", "tab:blue"      # the paper's Fig. 19 colours
 GEN_COLOR = {"extended": "tab:blue", "traditional": "tab:orange"}
-PAPER_SHARE = {"x": 67.5, "y": 57.4}
+SLUG = "forrest-biped"
 SWEEP_LABEL = {"cp_gain": "k = ", "gain_scale": "K_p × ", "mass_scale": "mass × "}
 
 
@@ -23,7 +24,7 @@ def knee_figure(run: Run, figures: Figures) -> None:
     for ax, col, label in zip(axes, ("speed_rad_s", "torque_Nm", "stiffness_Nm_per_rad"),
                               ("max. speed [rad/s]", "max. torque [N m]", "stiffness [N m/rad]"), strict=True):
         ax.plot(deg, knee[col])
-        ax.axvline(60, color="0.5", ls="--", lw=0.8, label="paper: extremum at 60°")
+        paper_vline(ax, paper_value(SLUG, "knee.torque_max", "deg"), label="paper: extremum at 60°", lw=0.8)
         ax.set_xlabel("knee flexion [°]")
         ax.set_ylabel(label)
     axes[1].legend()
@@ -230,7 +231,8 @@ def walking_figures(runs: dict[str, Run], errors: dict[str, Walk], shares: dict[
         ax.axvspan(1.0, 3.0, color="0.95", lw=0)
         ax.set_ylabel(f"CoM error {axis} [mm]")
         ax.set_title(f"({'ab'[k]}) share of 1-3 s with the smaller |error| for the extended generator: "
-                     f"{shares.get(axis, np.nan) * 100:.1f} % (paper {PAPER_SHARE[axis]} %)", fontsize=8)
+                     f"{shares.get(axis, np.nan) * 100:.1f} % (paper {paper_value(SLUG, f'share.{axis}', '%'):g} %)",
+                     fontsize=8)
     axes[0].legend(fontsize=7)
     axes[1].set_xlabel("t [s]")
     fig.suptitle("Fig. 20: CoM position error, extended vs traditional generator (same controller)")
@@ -292,7 +294,8 @@ def robustness_figure(table: pd.DataFrame, figures: Figures) -> None:
                         for key, value in (o.split("=") for o in job.split(","))) for job in table.index]
     for ax, axis in zip(axes, ("x", "y"), strict=True):
         ax.bar(range(len(table)), table[f"share.{axis}"] * 100, color="tab:blue", alpha=0.7, label="sweep jobs")
-        ax.axhline(PAPER_SHARE[axis], color="tab:red", ls="--", lw=1, label=f"paper {PAPER_SHARE[axis]} %")
+        paper = paper_value(SLUG, f"share.{axis}", "%")
+        paper_hline(ax, paper, label=f"paper {paper:g} %")
         ax.axhline(50, color="0.5", ls=":", lw=0.8)
         ax.set_xticks(range(len(table)), labels, fontsize=6)
         ax.set_title(f"share of 1-3 s with the smaller |CoM error {axis}| for the extended generator", fontsize=8)

@@ -247,7 +247,8 @@ def analyze_walking_metrics(runs: list[Run]) -> tuple[MetricTable, dict[str, dic
         errors[params] = {}
         for case, run in group.items():
             w = errors[params][case] = walk_errors(run)
-            m.add_run(run, walking_run_metrics(run) if case in GENERATORS else error_metrics(w, scenario_window(run)))
+            lipm = case.startswith("lipm")
+            m.add_run(run, error_metrics(w, scenario_window(run)) if lipm else walking_run_metrics(run))
         window = scenario_window(next(iter(group.values())))
         pair_id = "all" if params == "default" else f"all__{params}"
         # one pair per model: "extended"/"traditional" (MuJoCo), "lipm-extended"/"lipm-traditional", ...
