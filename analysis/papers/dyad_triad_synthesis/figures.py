@@ -10,7 +10,7 @@ import numpy as np
 import yaml
 
 from analysis.core.figures import Figures, plt
-from analysis.papers.dyad_triad_synthesis.metrics import METHODS, roots, scalars, vectors
+from analysis.papers.dyad_triad_synthesis.metrics import METHODS, case, roots, scalars, vectors
 from pipeline.core.runlog import Run
 
 ROOT_COLORS = {"trivial": "0.5", "special": "C1", "solution": "C3", "degenerate": "C4"}
@@ -143,8 +143,8 @@ def burmester_curves(runs: list[Run], figures: Figures) -> None:
 
 
 def four_bar(runs: list[Run], figures: Figures) -> None:
-    by_id = {r.run_id: r for r in runs}
-    defects, replay = by_id.get("defects"), by_id.get("replay-1to5")
+    by_case = {case(r): r for r in runs}
+    defects, replay = by_case.get("defects"), by_case.get("replay-1to5")
     if defects is not None and replay is not None:
         unit = _unit(replay)
         tf = replay["/tf"]
@@ -201,13 +201,13 @@ def four_bar(runs: list[Run], figures: Figures) -> None:
             axes[0].legend(fontsize=7)
         figures.save(fig, "branches")
 
-    servos = [r for r in runs if r.run_id.startswith("servo-")]
+    servos = [r for r in runs if case(r).startswith("servo-")]
     if servos:
         fig, axes = plt.subplots(2, 1, figsize=(7.5, 5), sharex=True)
         for k, run in enumerate(servos):
             err = run["/tracking_error"]
             axes[0].plot(err.index, np.degrees(err["error.driver"]), color=f"C{k}",
-                         label=run.run_id.removeprefix("servo-2to5-"))
+                         label=case(run).removeprefix("servo-2to5-"))
             cmd = run["/command"]
             axes[1].plot(cmd.index, cmd["value.rocker_B"], color=f"C{k}")
         axes[0].set_ylabel("rocker error q_ref − q [deg]")
@@ -220,9 +220,9 @@ def four_bar(runs: list[Run], figures: Figures) -> None:
 
 
 def round_trips(runs: list[Run], figures: Figures) -> None:
-    by_id = {r.run_id: r for r in runs}
-    counts = by_id.get("solution-counts")
-    triad7 = by_id.get("triad-7pp")
+    by_case = {case(r): r for r in runs}
+    counts = by_case.get("solution-counts")
+    triad7 = by_case.get("triad-7pp")
     if counts is None and triad7 is None:
         return
     fig, axes = plt.subplots(1, 2, figsize=(8, 3.2))

@@ -22,6 +22,11 @@ TOL_ON_CURVE = 1e-9          # |implicit condition| below this: the point lies o
 UNIT_CIRCLE = 1e-7           # | |z| − 1 | below this: a complex root is a real rotation
 
 
+def case(run: Run) -> str:
+    """The experiment case a run is of (its run id without the overrides' suffix)."""
+    return run.metadata.get("case", run.run_id)
+
+
 def vectors(run: Run, topic: str) -> dict[str, complex]:
     """A PlanarVectors record -> {name: x + iy}."""
     row = run[topic].iloc[0]
@@ -204,10 +209,10 @@ def _round_trips(run: Run) -> dict[str, tuple[float, str]]:
     def add(name: str, value: float, unit: str) -> None:
         out[name] = (float(value), unit)
 
-    if run.run_id == "table1":
+    if case(run) == "table1":
         for name, v in scalars(run, "/table1").iloc[0].items():
             add(name, v, "count")
-    elif run.run_id == "four-bars":
+    elif case(run) == "four-bars":
         d = scalars(run, "/round_trip")
         for k in ("dyad5.error_A", "dyad5.error_B", "dyad4.error_A", "dyad4.error_B"):
             add(f"{k}.max_relative", float((d[k] / d["scale"]).max()), "ratio")
@@ -220,7 +225,7 @@ def _round_trips(run: Run) -> dict[str, tuple[float, str]]:
         add("dyad5.solutions.min", float(d["dyad5.solutions"].min()), "count")
         add("dyad5.solutions.max", float(d["dyad5.solutions"].max()), "count")
         add("cases", len(d), "count")
-    elif run.run_id.startswith("triad-"):
+    elif case(run).startswith("triad-"):
         d = scalars(run, "/round_trip")
         add("recovered", float(((d["beta_error"] < 1e-8) & (d["vector_error"] < 1e-8 * d["scale"])).mean()),
             "fraction")
@@ -236,7 +241,7 @@ def _round_trips(run: Run) -> dict[str, tuple[float, str]]:
             add("missed_by_grid", float(d["missed_by_grid"].sum()), "count")
             add("newton_roots.max", float(d["newton_roots"].max()), "count")
         add("cases", len(d), "count")
-    elif run.run_id == "solution-counts":
+    elif case(run) == "solution-counts":
         d = scalars(run, "/solution_count")
         add("dyads_in_024", float(d["real_dyads"].isin([0, 2, 4]).mean()), "fraction")
         for n in (0, 2, 4):
@@ -264,7 +269,7 @@ def _four_bar(run: Run) -> dict[str, tuple[float, str]]:
     def add(name: str, value: float, unit: str) -> None:
         out[name] = (float(value), unit)
 
-    if run.run_id == "defects":
+    if case(run) == "defects":
         for name, v in scalars(run, "/defects").iloc[0].items():
             unit = "rad" if ("range" in name or "transmission" in name) else (
                 "m" if ("length" in name or "margin" in name) else "")

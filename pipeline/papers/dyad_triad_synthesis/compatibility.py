@@ -187,7 +187,9 @@ class Compatibility:
             k = best[i, j]
             seeds.append(beta[i + k % 2, j + k // 2])
         beta = self.newton(np.concatenate(seeds))
-        return [Root(b, 0) for b in beta[self.converged(beta)]]
+        beta = beta[self.converged(beta)]
+        _, first = np.unique(np.round(wrapped(beta), 6), axis=0, return_index=True)   # most seeds find the same
+        return [Root(b, 0) for b in beta[np.sort(first)]]
 
     # -- every compatibility equation at once (no closure, no branches) --------------------------------------
     @property
@@ -244,10 +246,12 @@ class Compatibility:
 def unique(roots: list[Root], same: float) -> list[Root]:
     """Roots with distinct β (modulo 2π), sorted by β2, β3, …"""
     out: list[Root] = []
+    kept = np.empty((0, len(roots[0].beta) if roots else 0))
     for root in roots:
-        if all(np.abs(np.remainder(root.beta - r.beta + math.pi, 2 * math.pi) - math.pi).max() > same for r in out):
+        if not (np.abs(wrapped(kept - root.beta)).max(axis=1, initial=0.0) <= same).any():
             out.append(root)
-    return sorted(out, key=lambda r: tuple(np.round(np.remainder(r.beta + math.pi, 2 * math.pi) - math.pi, 9)))
+            kept = np.vstack([kept, root.beta])
+    return sorted(out, key=lambda r: tuple(np.round(wrapped(r.beta), 9)))
 
 
 def wrapped(x) -> np.ndarray:

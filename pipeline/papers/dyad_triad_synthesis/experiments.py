@@ -5,6 +5,8 @@ the analysis needs to rebuild the paper's numbers; lengths in m, angles in rad."
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from omegaconf import DictConfig
@@ -504,60 +506,113 @@ def four_bar(cfg: DictConfig) -> list[Case]:
 
     def servo(log: RunWriter, controller: str) -> None:
         fb, poses, points, alpha = paper_four_bar(cfg)
-        legs = [fourbar.leg(fb, "B", poses[j], poses[j + 1]) for j in range(1, len(poses) - 1)]
-        if any(leg.toggles for leg in legs) or len({leg.branches[0] for leg in legs}) != 1:
-            raise SimulationFailed("poses 2-5 are not on one branch of the rocker drive")
-        branch = legs[0].branches[0]
-        start_rotation, end_rotation = legs[0].start, legs[-1].end
-        model = multibody.ExudynFourBar(fb, link.line_density, ex.servo_dt, ex.control_dt, ex.spectral_radius,
-                                        ex.newton_tolerance, start=fb.solve("B", start_rotation, branch))
-        log.attach("model.yaml", _model_yaml(model, cfg), "application/yaml")
-        periods = round((sc.move_duration + sc.hold_duration) / ex.control_dt)
-        t_ref = np.arange(periods + 1) * ex.control_dt
-        shape, rate, accel = _quintic(t_ref / sc.move_duration)
-        span = end_rotation - start_rotation
-        q_ref = start_rotation + span * shape
-        qd_ref, qdd_ref = span * rate / sc.move_duration, span * accel / sc.move_duration ** 2
-        j_ref, dj_ref = multibody.reduced_inertia(fb, model.bodies, "B", q_ref, branch)
-        omega = 2 * math.pi * ex.bandwidth_hz
-        kp, kd = omega ** 2, 2 * ex.damping_ratio * omega
-        torque = np.zeros(periods)
-        try:
-            for k in range(periods):
-                q, qd = model.state()
-                e, ed = q_ref[k] - q[2, 2], qd_ref[k] - qd[2, 2]
-                if controller == "computed-torque":   # on the reference, from the closed-form model
-                    torque[k] = j_ref[k] * (qdd_ref[k] + kd * ed + kp * e) + 0.5 * dj_ref[k] * qd_ref[k] ** 2
-                else:
-                    torque[k] = j_ref[0] * (kd * ed + kp * e)
-                model.advance(torque=torque[k])
-        finally:
-            model.finish()
-        t, q, qd = model.fine()
-        k_ref = np.minimum(np.rint(t / ex.control_dt).astype(int), periods)
-        reference = {"name": ["rocker_B"], "position": q_ref[k_ref][:, None],
-                     "velocity": qd_ref[k_ref][:, None], "acceleration": qdd_ref[k_ref][:, None]}
-        _log_motion(log, cfg, model, t, q, qd, reference, np.full(len(t), "B"), np.full(len(t), branch), points)
-        t_cmd = np.arange(periods) * ex.control_dt
-        log.log_series("/command", t_cmd, kind="torque", name=["rocker_B"], value=torque[:, None])
-        # passage through positions 2..5: closest approach of the tracer, coupler error there
-        tracer = multibody.points_of(model.bodies, q, 1, fb.p)
-        for j in range(2, len(points) + 1):
-            k = int(np.argmin(np.abs(tracer - points[j - 1])))
-            log_scalars(log, "/passage", float(t[k]), {
-                "position": j, "distance": abs(tracer[k] - points[j - 1]),
-                "coupler_error": math.remainder(q[k, 1, 2] - alpha[j - 1], 2 * math.pi)})
+        run = servo_2to5(cfg, fb, poses, controller)
+        log.attach("model.yaml", _model_yaml(run.model, cfg), "application/yaml")
+        log_servo(log, cfg, run, points, alpha)
 
     return [Case("defects", defects), Case("replay-1to5", replay),
             *(Case(f"servo-2to5-{c}", lambda log, c=c: servo(log, c)) for c in sc.controllers)]
 
 
+@dataclass
+class ServoRun:
+    """The 2→5 servo run: the model, its fine-step samples, the reference and the torques per period."""
+
+    model: multibody.ExudynFourBar
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    reference: dict
+    torque: np.ndarray
+    branch: int
+
+
+def servo_2to5(cfg: DictConfig, fb: FourBar, poses: list[dict[str, float]], controller: str) -> ServoRun:
+    """The rocker servoed from pose 2 to pose 5 (rest-to-rest quintic, then held): PD with gains scaled by the
+    reduced inertia J, and for `computed-torque` the model's J(q_ref) q̈_ref + ½ J'(q_ref) q̇_ref² added."""
+    sc, ex = cfg.scenario, cfg.execute
+    legs = [fourbar.leg(fb, "B", poses[j], poses[j + 1]) for j in range(1, len(poses) - 1)]
+    if any(leg.toggles for leg in legs) or len({leg.branches[0] for leg in legs}) != 1:
+        raise SimulationFailed("poses 2-5 are not on one branch of the rocker drive")
+    branch = legs[0].branches[0]
+    start_rotation, end_rotation = legs[0].start, legs[-1].end
+    model = multibody.ExudynFourBar(fb, cfg.system.linkage.line_density, ex.servo_dt, ex.control_dt,
+                                    ex.spectral_radius, ex.newton_tolerance,
+                                    start=fb.solve("B", start_rotation, branch))
+    periods = round((sc.move_duration + sc.hold_duration) / ex.control_dt)
+    t_ref = np.arange(periods + 1) * ex.control_dt
+    shape, rate, accel = _quintic(t_ref / sc.move_duration)
+    span = end_rotation - start_rotation
+    q_ref = start_rotation + span * shape
+    qd_ref, qdd_ref = span * rate / sc.move_duration, span * accel / sc.move_duration ** 2
+    j_ref, dj_ref = multibody.reduced_inertia(fb, model.bodies, "B", q_ref, branch)
+    omega = 2 * math.pi * ex.bandwidth_hz
+    kp, kd = omega ** 2, 2 * ex.damping_ratio * omega
+    torque = np.zeros(periods)
+    try:
+        for k in range(periods):
+            q, qd = model.state()
+            e, ed = q_ref[k] - q[2, 2], qd_ref[k] - qd[2, 2]
+            if controller == "computed-torque":   # on the reference, from the closed-form model
+                torque[k] = j_ref[k] * (qdd_ref[k] + kd * ed + kp * e) + 0.5 * dj_ref[k] * qd_ref[k] ** 2
+            else:
+                torque[k] = j_ref[0] * (kd * ed + kp * e)
+            model.advance(torque=torque[k])
+    finally:
+        model.finish()
+    t, q, qd = model.fine()
+    k_ref = np.minimum(np.rint(t / ex.control_dt).astype(int), periods)
+    reference = {"name": ["rocker_B"], "position": q_ref[k_ref][:, None], "velocity": qd_ref[k_ref][:, None],
+                 "acceleration": qdd_ref[k_ref][:, None]}
+    return ServoRun(model, t, q, qd, reference, torque, branch)
+
+
+def log_servo(log: RunWriter, cfg: DictConfig, run: ServoRun, points: np.ndarray, alpha: np.ndarray) -> None:
+    """The servo run's motion and torques, and its passage through positions 2..5 (the tracer's closest
+    approach, the coupler's error there)."""
+    t, q = run.t, run.q
+    _log_motion(log, cfg, run.model, t, q, run.qd, run.reference, np.full(len(t), "B"), np.full(len(t), run.branch),
+                points)
+    log.log_series("/command", np.arange(len(run.torque)) * cfg.execute.control_dt, kind="torque",
+                   name=["rocker_B"], value=run.torque[:, None])
+    tracer = multibody.points_of(run.model.bodies, q, 1, run.model.fourbar.p)
+    for j in range(2, len(points) + 1):
+        k = int(np.argmin(np.abs(tracer - points[j - 1])))
+        log_scalars(log, "/passage", float(t[k]), {
+            "position": j, "distance": abs(tracer[k] - points[j - 1]),
+            "coupler_error": math.remainder(q[k, 1, 2] - alpha[j - 1], 2 * math.pi)})
+
+
 # -- compute-time ------------------------------------------------------------------------------------------
+
+
+def solvers(cfg: DictConfig) -> dict[str, Callable[[np.ndarray, np.ndarray], list[np.ndarray]]]:
+    """The dyad in five positions solved three ways: (points, α) -> the finite dyads [W, Z] each finds."""
+    sc = cfg.scenario
+    settings = search_settings(cfg)
+
+    def sweep(p, a):
+        return [f.vectors for f in dyads_of(synthesize(dyad(p, a), **settings))]
+
+    def least_squares(p, a):
+        return [np.array(d) for d in burmester.least_squares_dyads(p, a, sc.least_squares_starts,
+                                                                   np.random.default_rng(cfg.seed))]
+
+    def newton(p, a):
+        chain = dyad(p, a)
+        compat = Compatibility(chain)
+        starts = np.zeros((sc.newton_starts, chain.n))
+        starts[:, 1:] = np.random.default_rng(cfg.seed).uniform(-math.pi, math.pi, (sc.newton_starts, chain.n - 1))
+        beta = compat.newton(starts)
+        roots = unique([Root(b, 0) for b in beta[compat.converged(beta)]], settings["same"])
+        return [link_vectors(chain, r.beta).vectors for r in roots
+                if classify(chain, r.beta, settings["special_tol"], settings["conditioning"]) == "solution"]
+
+    return {"compatibility_sweep": sweep, "least_squares": least_squares, "random_newton": newton}
 
 
 def compute_time(cfg: DictConfig) -> list[Case]:
     sc = cfg.scenario
-    settings = search_settings(cfg)
 
     def simulate(log: RunWriter) -> None:
         rng = np.random.default_rng(cfg.seed)
@@ -567,29 +622,12 @@ def compute_time(cfg: DictConfig) -> list[Case]:
             s = synthetic.random_four_bar(rng)
             problems.append((f"four-bar-{k}", s.points, s.alpha))
 
-        def sweep(p, a):
-            return [f.vectors for f in dyads_of(synthesize(dyad(p, a), **settings))]
-
-        def least_squares(p, a):
-            return [np.array(d) for d in burmester.least_squares_dyads(p, a, sc.least_squares_starts,
-                                                                       np.random.default_rng(cfg.seed))]
-
-        def newton(p, a):
-            chain = dyad(p, a)
-            compat = Compatibility(chain)
-            starts = np.zeros((sc.newton_starts, chain.n))
-            starts[:, 1:] = np.random.default_rng(cfg.seed).uniform(-math.pi, math.pi, (sc.newton_starts, chain.n - 1))
-            beta = compat.newton(starts)
-            roots = unique([Root(b, 0) for b in beta[compat.converged(beta)]], settings["same"])
-            return [link_vectors(chain, r.beta).vectors for r in roots
-                    if classify(chain, r.beta, settings["special_tol"], settings["conditioning"]) == "solution"]
-
-        methods = {"compatibility_sweep": sweep, "least_squares": least_squares, "random_newton": newton}
+        methods = solvers(cfg)
         t = 0.0
         for k, (name, p, a) in enumerate(problems):
             timings = time_interleaved({m: (fn, (p, a), 1) for m, fn in methods.items()}, warmup=1,
                                        repeats=sc.repeats)
-            reference = sweep(p, a)
+            reference = methods["compatibility_sweep"](p, a)
             found = {}
             for m, fn in methods.items():
                 dyads = fn(p, a)
