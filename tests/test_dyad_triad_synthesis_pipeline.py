@@ -40,6 +40,8 @@ def test_worked_example_and_four_bar_to_report(data_dir):
     assert "model.yaml" in replay.attachments
     markers = replay["/markers"]
     assert markers.filter(like="cylinders").shape[1] > 0 and markers.filter(like="lines").shape[1] > 0
+    ids = markers.filter(regex=r"^entities\.\d+\.id$").iloc[0].tolist()
+    assert len(ids) == len(set(ids))                   # Foxglove replaces an entity by a later one of the same id
     assert {"/command", "/passage"} <= set(runs["servo-2to5-computed-torque"].topic_names)
 
     targets = pd.read_csv(data_dir / "report" / "targets.csv").set_index("target_id")
@@ -83,8 +85,8 @@ def test_five_positions_without_two_dyads_is_a_failed_run_not_a_crash():
         alpha = np.concatenate([[0], np.cumsum(rng.uniform(3, 45, 4))])
         if not any(f.label == "solution" for f in synthesize(dyad(points * 0.01, np.radians(alpha)))):
             break
-    cfg = compose_config([f"experiment={SLUG}/four-bar",
-                          f"system.table4.points={[[round(float(p.real), 3), round(float(p.imag), 3)] for p in points]}",
+    rows = [[round(float(p.real), 3), round(float(p.imag), 3)] for p in points]
+    cfg = compose_config([f"experiment={SLUG}/four-bar", f"system.table4.points={rows}",
                           f"system.table4.alpha_deg={[round(float(a), 3) for a in alpha]}"])
     case = next(c for c in experiments.four_bar(cfg) if c.id == "replay-1to5")
     with pytest.raises(SimulationFailed, match="gives 0 dyads"):

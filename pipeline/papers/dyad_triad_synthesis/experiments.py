@@ -369,11 +369,13 @@ def _scene(model: multibody.ExudynFourBar, path: np.ndarray, targets: np.ndarray
         return xyz(z - origin)
 
     entities = [
-        markers.rods("crank_A", "crank_A", [((0, 0, 0), local(f.a1, f.a0))], radius, (0.85, 0.33, 0.1, 1.0)),
-        markers.rods("coupler", "coupler", [((0, 0, 0), local(f.b1, f.a1)), ((0, 0, 0), local(f.p, f.a1)),
-                                            (local(f.b1, f.a1), local(f.p, f.a1))], radius, (0.2, 0.45, 0.75, 1.0)),
-        markers.rods("rocker_B", "rocker_B", [((0, 0, 0), local(f.b1, f.b0))], radius, (0.3, 0.65, 0.3, 1.0)),
-        markers.rods("ground", "world", [(xyz(f.a0), xyz(f.b0))], radius / 2, (0.4, 0.4, 0.4, 1.0)),
+        # entity ids differ from the frame names: the pivot spheres below are named after their frames
+        markers.rods("crank_A.link", "crank_A", [((0, 0, 0), local(f.a1, f.a0))], radius, (0.85, 0.33, 0.1, 1.0)),
+        markers.rods("coupler.link", "coupler", [((0, 0, 0), local(f.b1, f.a1)), ((0, 0, 0), local(f.p, f.a1)),
+                                                 (local(f.b1, f.a1), local(f.p, f.a1))], radius,
+                     (0.2, 0.45, 0.75, 1.0)),
+        markers.rods("rocker_B.link", "rocker_B", [((0, 0, 0), local(f.b1, f.b0))], radius, (0.3, 0.65, 0.3, 1.0)),
+        markers.rods("ground.link", "world", [(xyz(f.a0), xyz(f.b0))], radius / 2, (0.4, 0.4, 0.4, 1.0)),
         *markers.spheres(["crank_A", "rocker_B", "tracer"], [2 * radius] * 3, [(0.1, 0.1, 0.1, 1.0)] * 3),
         markers.line_strip("tracer_path", np.column_stack([path.real, path.imag, np.zeros(len(path))]),
                            thickness=radius / 2, color=(0.8, 0.1, 0.1, 1.0)),
