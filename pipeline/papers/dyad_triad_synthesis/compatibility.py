@@ -24,6 +24,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.polynomial import polynomial as poly
 from scipy.optimize import brentq
 
 from pipeline.papers.dyad_triad_synthesis.standard_form import Chain, Loop, link_vectors, loops, turns
@@ -77,7 +78,7 @@ def intersect(a: list[tuple[float, float]], b: list[tuple[float, float]]) -> lis
 @dataclass(frozen=True)
 class Root:
     beta: np.ndarray   # (n,) rotations β of positions 1..n [rad], β_1 = 0
-    branch: int        # assembly of loop 1's closing triangle
+    branch: int        # assembly of loop 1's closing triangle (0: found by Newton on every loop at once)
 
 
 class Compatibility:
@@ -320,8 +321,6 @@ def isotropic_roots(loop_list: list[Loop], tol: float = 1e-9) -> np.ndarray:
 
     Their resultant in z3 is a polynomial in z2 (z2 = 0 is spurious: the equations were multiplied by it);
     each of its roots gives z3 by eliminating z3². Real β are the roots with |z2| = |z3| = 1."""
-    from numpy.polynomial import polynomial as poly
-
     def coefficients(loop: Loop) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         c, (a, b), r2 = loop.fixed, loop.shared, abs(loop.last) ** 2
         cc, ac, bc = np.conj(c), np.conj(a), np.conj(b)
@@ -340,6 +339,6 @@ def isotropic_roots(loop_list: list[Loop], tol: float = 1e-9) -> np.ndarray:
         if abs(z2) < tol:
             continue
         z3 = -poly.polyval(z2, p) / poly.polyval(z2, q)     # B2·E1 − A2·E2 = −(q z3 + p) = 0
-        if all(abs(z2 - o[0]) > tol * (1 + abs(z2)) for o in out):
+        if all(max(abs(z2 - o[0]), abs(z3 - o[1])) > tol * (1 + abs(z2) + abs(z3)) for o in out):
             out.append((z2, z3))
     return np.array(out, dtype=complex).reshape(-1, 2)

@@ -9,6 +9,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+import yaml
 from omegaconf import DictConfig
 
 from pipeline.core import markers, schemas
@@ -28,6 +29,7 @@ from pipeline.papers.dyad_triad_synthesis.compatibility import (
     reachable_intervals,
     synthesize,
     unique,
+    wrapped,
 )
 from pipeline.papers.dyad_triad_synthesis.fourbar import LINKS, FourBar
 from pipeline.papers.dyad_triad_synthesis.standard_form import dyad, link_vectors, loops, system_rank, triad
@@ -201,7 +203,7 @@ def burmester_curves(cfg: DictConfig) -> list[Case]:
 
 
 def _angle_error(a, b) -> float:
-    return float(np.abs(np.remainder(np.asarray(a) - np.asarray(b) + math.pi, 2 * math.pi) - math.pi).max())
+    return float(np.abs(wrapped(np.asarray(a) - np.asarray(b))).max())
 
 
 def _closest(found: list[Synthesized], vectors: np.ndarray) -> tuple[float, int]:
@@ -224,9 +226,8 @@ def round_trips(cfg: DictConfig) -> list[Case]:
         for kind, sizes in (("dyad", range(2, 6)), ("triad", range(2, 8))):
             for n in sizes:
                 if kind == "dyad":
-                    sample = synthetic.random_four_bar(rng, n) if n > 2 else synthetic.random_four_bar(rng, 3)
-                    pts, al, beta = sample.points[:n], sample.alpha[:n], sample.beta_a[:n]
-                    chain, vectors = dyad(pts, al), np.array(sample.dyads()[0])
+                    sample = synthetic.random_four_bar(rng, n)
+                    chain, vectors, beta = dyad(sample.points, sample.alpha), np.array(sample.dyads()[0]), sample.beta_a
                 else:
                     t = synthetic.random_triad(rng, n, ungrounded=False)
                     chain, vectors, beta = triad(t.points, t.alpha, t.gamma, t.h), t.vectors, t.beta
@@ -303,7 +304,6 @@ def round_trips(cfg: DictConfig) -> list[Case]:
     return [Case("table1", table1), Case("four-bars", four_bars),
             *(Case(f"triad-{n}pp", lambda log, n=n: triads(log, n)) for n in (5, 6, 7)),
             Case("solution-counts", solution_counts)]
-
 
 
 # -- four-bar: closed form and Exudyn ------------------------------------------------------------------------
@@ -386,8 +386,7 @@ def _scene(model: multibody.ExudynFourBar, path: np.ndarray, targets: np.ndarray
 
 
 def _model_yaml(model: multibody.ExudynFourBar, cfg: DictConfig) -> str:
-    import yaml
-
+    """The Exudyn model's parameters, attached to the run (the model is generated from them)."""
     f = model.fourbar
     pivots = {k: [float(getattr(f, k).real), float(getattr(f, k).imag)] for k in ("a0", "a1", "b0", "b1", "p")}
     return yaml.safe_dump({
