@@ -49,6 +49,7 @@ def test_worked_example_and_four_bar_to_report(data_dir):
                    "S2.3.six_sets", "S2.3.special", "F14.position", "F14.angle"):
         assert targets.loc[target, "status"] == "match", target
     assert targets.loc["S2.5.delta_loop_limits", "status"] == "miss"     # the paper's statement, refuted
+    assert (targets.loc[["C5.eq13", "C5.eq19", "C5.alignment"], "status"] == "agrees").all()
     assert targets.loc["T1.triad_sets", "status"] == "not run"           # round-trips not run here
     metrics = pd.read_parquet(data_dir / "metrics" / SLUG / "four-bar.parquet").set_index(["run_id", "metric"])
     assert metrics.loc[("replay-1to5", "positions.max_error"), "value"] < 1e-10

@@ -107,6 +107,16 @@ def _table5(run: Run) -> dict[str, tuple[float, str]]:
         add(f"beta2_range.{loop}.upper", max(hi), "rad")
         add(f"beta2_range.{loop}.measure", measure[loop], "rad")
     add("delta_loop_more_limiting", float(measure["delta"] < measure["delta_prime"]), "bool")
+    # the paper against itself: Table 5 as printed closes eqs. (13) and (19) and gives Sec. 2.5's rotation
+    unit = run.config["system"]["length_unit"]
+    printed = {k: complex(*v) * unit for k, v in run.config["printed"]["table5"].items()}
+    add("printed.eq13_residual", abs(printed["Δ1"] + printed["Δ2"] + printed["Δ3"] + printed["Δ4"]), "m")
+    add("printed.eq19_residual", abs(printed["Δ1'"] + printed["Δ2'"] + printed["Δ3'"] + printed["Δ4"]), "m")
+    turn = math.remainder(np.angle(printed["Δ2"]) - np.angle(printed["Δ2'"]), 2 * math.pi)
+    add("printed.alignment_rotation", turn, "rad")
+    bar = printed["Δ2'"] * np.exp(1j * turn) - printed["Δ2"]
+    add("printed.parallelogram.re", bar.real, "m")
+    add("printed.parallelogram.im", bar.imag, "m")
     # the roots
     found = roots(run)
     dyads = found[found["label"] == "solution"].sort_values("W", key=lambda s: s.abs()).reset_index(drop=True)
