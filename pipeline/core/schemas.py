@@ -15,6 +15,7 @@ from foxglove_schemas_protobuf.CubePrimitive_pb2 import CubePrimitive
 from foxglove_schemas_protobuf.CylinderPrimitive_pb2 import CylinderPrimitive
 from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
 from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
+from foxglove_schemas_protobuf.LinePrimitive_pb2 import LinePrimitive
 from foxglove_schemas_protobuf.Point3_pb2 import Point3
 from foxglove_schemas_protobuf.Pose_pb2 import Pose
 from foxglove_schemas_protobuf.PosesInFrame_pb2 import PosesInFrame
@@ -118,9 +119,9 @@ def for_topic(topic: str) -> type[Message] | None:
     return None
 
 
-__all__ = ["TOPICS", "Color", "CubePrimitive", "CylinderPrimitive", "FrameTransform", "FrameTransforms", "Point3",
-           "Pose", "PosesInFrame", "Quaternion", "SceneEntity", "SceneUpdate", "SpherePrimitive",
-           "TriangleListPrimitive", "Vector3", "define", "for_topic", "stamp"]
+__all__ = ["TOPICS", "Color", "CubePrimitive", "CylinderPrimitive", "FrameTransform", "FrameTransforms",
+           "LinePrimitive", "Point3", "Pose", "PosesInFrame", "Quaternion", "SceneEntity", "SceneUpdate",
+           "SpherePrimitive", "TriangleListPrimitive", "Vector3", "define", "for_topic", "stamp"]
 
 
 def stamp(t_ns: int) -> timestamp_pb2.Timestamp:
