@@ -1,7 +1,7 @@
 """Shapes to draw on `/markers` (Foxglove SceneUpdate): Foxglove's 3D panel renders them natively, and
 `python -m analysis.view` draws them in Rerun. An entity lives in a /tf frame and moves with it: spheres on
-frames, capsules and cones between points, height fields (terrain), and a generated MuJoCo model drawn from its
-own geoms (`mujoco_geoms`)."""
+frames, capsules, cones and rods between points, line strips (paths), height fields (terrain), and a generated
+MuJoCo model drawn from its own geoms (`mujoco_geoms`)."""
 
 from __future__ import annotations
 
@@ -23,42 +23,6 @@ def spheres(frames: Sequence[str], radii: Sequence[float], colors: Sequence[Sequ
         spheres=[schemas.SpherePrimitive(pose=schemas.Pose(orientation=schemas.Quaternion(w=1.0)),
                                          size=schemas.Vector3(x=2 * r, y=2 * r, z=2 * r), color=_color(c))])
         for frame, r, c in zip(frames, radii, colors, strict=True)]
-
-
-def _along(a: np.ndarray, b: np.ndarray) -> schemas.Pose:
-    """Pose of a cylinder from a to b: its centre at the midpoint, its z axis (Foxglove's cylinder axis) along b − a."""
-    d = b - a
-    z = d / np.linalg.norm(d)
-    axis = np.cross([0.0, 0.0, 1.0], z)
-    s, c = np.linalg.norm(axis), float(z[2])
-    half = np.arctan2(s, c) / 2
-    axis = axis / s if s > 1e-12 else np.array([1.0, 0.0, 0.0])
-    q = np.concatenate([[np.cos(half)], np.sin(half) * axis])
-    mid = (a + b) / 2
-    return schemas.Pose(position=schemas.Vector3(x=mid[0], y=mid[1], z=mid[2]),
-                        orientation=schemas.Quaternion(w=q[0], x=q[1], y=q[2], z=q[3]))
-
-
-def rods(name: str, frame: str, segments: Sequence[tuple[Sequence[float], Sequence[float]]], radius: float,
-         color: Sequence[float]):
-    """Cylinders of one radius joining each (start, end) pair of points given in `frame`: the links of a
-    linkage drawn in their own /tf frames."""
-    cylinders = []
-    for a, b in segments:
-        a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-        length = float(np.linalg.norm(b - a))
-        cylinders.append(schemas.CylinderPrimitive(pose=_along(a, b), color=_color(color),
-                                                   size=schemas.Vector3(x=2 * radius, y=2 * radius, z=length)))
-    return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True, cylinders=cylinders)
-
-
-def line_strip(name: str, points: np.ndarray, frame: str = "world", thickness: float = 0.005,
-               color: Sequence[float] = (0.2, 0.2, 0.2, 1.0)):
-    """A polyline through `points` (N, 3) in `frame` (a path: of a tracer point, a foot, an end effector)."""
-    line = schemas.LinePrimitive(type=schemas.LinePrimitive.LINE_STRIP, thickness=thickness, color=_color(color),
-                                 pose=schemas.Pose(orientation=schemas.Quaternion(w=1.0)),
-                                 points=[schemas.Point3(x=x, y=y, z=z) for x, y, z in np.asarray(points).tolist()])
-    return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True, lines=[line])
 
 
 def height_field(name: str, x: np.ndarray, y: np.ndarray, z: np.ndarray, frame: str = "world",
@@ -112,7 +76,7 @@ def _cube(centre, quat_wxyz, size: Sequence[float], color) -> schemas.CubePrimit
                                  size=schemas.Vector3(x=float(size[0]), y=float(size[1]), z=float(size[2])))
 
 
-def capsule(frame: str, name: str, start: Sequence[float], end: Sequence[float], radius: float,
+def capsule(name: str, frame: str, start: Sequence[float], end: Sequence[float], radius: float,
             color: Sequence[float]):
     """A capsule (a cylinder with a sphere at each end) from `start` to `end` in /tf frame `frame`."""
     return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True,
@@ -120,11 +84,28 @@ def capsule(frame: str, name: str, start: Sequence[float], end: Sequence[float],
                                spheres=[_ball(p, radius, color) for p in (start, end)])
 
 
-def cone(frame: str, name: str, start: Sequence[float], end: Sequence[float], radius_start: float,
+def cone(name: str, frame: str, start: Sequence[float], end: Sequence[float], radius_start: float,
          radius_end: float, color: Sequence[float]):
     """A truncated cone from `start` (radius_start) to `end` (radius_end) in /tf frame `frame`."""
     return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True,
                                cylinders=[_cylinder(start, end, radius_start, radius_end, color)])
+
+
+def rods(name: str, frame: str, segments: Sequence[tuple[Sequence[float], Sequence[float]]], radius: float,
+         color: Sequence[float]):
+    """Cylinders of one radius joining each (start, end) pair of points given in `frame`: the links of a
+    linkage drawn in their own /tf frames."""
+    return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True,
+                               cylinders=[_cylinder(a, b, radius, radius, color) for a, b in segments])
+
+
+def line_strip(name: str, points: np.ndarray, frame: str = "world", thickness: float = 0.005,
+               color: Sequence[float] = (0.2, 0.2, 0.2, 1.0)):
+    """A polyline through `points` (N, 3) in `frame` (a path: of a tracer point, a foot, an end effector)."""
+    line = schemas.LinePrimitive(type=schemas.LinePrimitive.LINE_STRIP, thickness=thickness, color=_color(color),
+                                 pose=_pose((0.0, 0.0, 0.0)),
+                                 points=[schemas.Point3(x=x, y=y, z=z) for x, y, z in np.asarray(points).tolist()])
+    return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True, lines=[line])
 
 
 def _z_axis(quat_wxyz: Sequence[float]) -> np.ndarray:

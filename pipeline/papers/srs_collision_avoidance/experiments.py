@@ -134,12 +134,12 @@ def log_scene(log: RunWriter, cfg: DictConfig, arms: HumanArms, g: Geometry) -> 
     r, vol = cfg.system.dynamics.link_radius, cfg.system.safety
     grey, orange = (0.45, 0.45, 0.5, 1.0), (0.95, 0.55, 0.15, 1.0)
     safety, skin = (0.2, 0.6, 1.0, 0.18), (0.85, 0.6, 0.45, 1.0)
-    entities = [markers.capsule("base", "column", [0, 0, 0], [0, g.a0, 0], r, grey),
-                markers.capsule("link3", "upper_arm", [0, 0, 0], [g.a1, 0, 0], r, orange),
-                markers.capsule("link5", "forearm", [0, 0, 0], [g.a2, 0, 0], r, orange),
-                markers.capsule("link7", "tool", [0, 0, 0], [g.a3, 0, 0], 0.6 * r, grey),
-                markers.cone("link3", "safety/upper_arm", [0, 0, 0], [g.a1, 0, 0], vol.d_cmin, vol.d_cmax, safety),
-                markers.cone("link5", "safety/forearm", [0, 0, 0], [g.a2, 0, 0], vol.d_cmax, vol.d_cmin, safety),
+    entities = [markers.capsule("column", "base", [0, 0, 0], [0, g.a0, 0], r, grey),
+                markers.capsule("upper_arm", "link3", [0, 0, 0], [g.a1, 0, 0], r, orange),
+                markers.capsule("forearm", "link5", [0, 0, 0], [g.a2, 0, 0], r, orange),
+                markers.capsule("tool", "link7", [0, 0, 0], [g.a3, 0, 0], 0.6 * r, grey),
+                markers.cone("safety/upper_arm", "link3", [0, 0, 0], [g.a1, 0, 0], vol.d_cmin, vol.d_cmax, safety),
+                markers.cone("safety/forearm", "link5", [0, 0, 0], [g.a2, 0, 0], vol.d_cmax, vol.d_cmin, safety),
                 *markers.spheres(["link4"], [vol.d_cmax], [safety])]
     lengths = np.tile([arms.upper_length, arms.fore_length], len(arms.base))
     radii = np.tile(arms.radius, len(arms.base))
