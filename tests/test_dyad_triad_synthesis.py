@@ -1,4 +1,4 @@
-"""dyad-triad-synthesis: the spec §8 checks. Table 5 and the worked example from the algorithm, the cofactor
+"""dyad-triad-synthesis: Table 5 and the worked example from the algorithm, the cofactor
 expansion, rank at every solution, agreement with an independent Burmester solve and with every complex root,
 synthetic round trips of dyads and triads, Burmester curves through the poles, Table 1's counts, the closed-form
 four-bar against Exudyn, and refusals of impossible problems."""
@@ -12,6 +12,8 @@ import numpy as np
 import pytest
 import yaml
 
+from analysis.core.targets import paper_value
+from analysis.papers.dyad_triad_synthesis.metrics import PRINTED_TABLE5
 from pipeline.papers.dyad_triad_synthesis import burmester, fourbar, multibody, synthetic
 from pipeline.papers.dyad_triad_synthesis.compatibility import (
     Compatibility,
@@ -23,10 +25,11 @@ from pipeline.papers.dyad_triad_synthesis.standard_form import dyad, link_vector
 
 from .conftest import ROOT
 
+SLUG = "dyad-triad-synthesis"
 SYSTEM = yaml.safe_load((ROOT / "conf/system/dyad-triad-synthesis.yaml").read_text())
-# Table 5 as printed (paper units): the target the algorithm is compared with, never an output
-TABLE5 = {"Δ1": -1.2736 + 0.1990j, "Δ2": 0.9214 - 3.4612j, "Δ3": 1.5541 + 3.7924j, "Δ4": -1.2018 - 0.5302j,
-          "Δ1'": -3.3851 + 1.1261j, "Δ2'": 5.2149 - 9.7840j, "Δ3'": -0.6280 + 9.1881j}
+# Table 5 as printed (paper units, read from targets.csv): the target the algorithm is compared with
+TABLE5 = {name: complex(paper_value(SLUG, f"T5.{key}.re"), paper_value(SLUG, f"T5.{key}.im"))
+          for name, key in PRINTED_TABLE5.items()}
 
 
 @pytest.fixture(scope="module")
@@ -50,9 +53,10 @@ def test_table5_and_the_alignment_rotation_from_table4(table4):
     for name, printed in TABLE5.items():
         assert abs(delta[name] / unit - printed) < 1e-3, name
     rotation = math.degrees(np.angle(delta["Δ2"]) - np.angle(delta["Δ2'"]))
-    assert rotation == pytest.approx(-13.15, abs=0.005)
+    assert rotation == pytest.approx(paper_value(SLUG, "S2.5.alignment"), abs=0.005)
     bar = (delta["Δ2'"] * np.exp(1j * math.radians(rotation)) - delta["Δ2"]) / unit
-    assert abs(bar - (1.9307 - 7.2528j)) < 2e-3          # Sec. 2.5's "Δ2 − Δ2'" is this vector
+    printed_bar = complex(paper_value(SLUG, "S2.5.parallelogram.re"), paper_value(SLUG, "S2.5.parallelogram.im"))
+    assert abs(bar - printed_bar) < 2e-3          # Sec. 2.5's "Δ2 − Δ2'" is this vector
 
 
 def test_compatibility_equation_is_the_cofactor_expansion_of_the_determinant():

@@ -62,6 +62,8 @@ def test_worked_example_and_four_bar_to_report(data_dir):
     "scenario.four_bars=1000000000", "scenario.triads=0", "system.search.grid=5", "scenario.newton_starts=1e12",
     "system.linkage.line_density=-1", "scenario.controllers=[bogus]", "execute.servo_dt=0",
     "scenario.leg_duration=1e9", "system.table4.alpha_deg=[0,1,2,3,nan]",
+    "system.table4.points=[[1,2],[3,4]]", "system.table4.points=[[1,2,3],[1,2],[1,2],[1,2],[1,2]]",  # shapes
+    "execute.servo_dt=0.01",                                                        # coarser than the servo
 ])
 def test_bad_input_is_refused_in_one_line(override):
     experiment = {"four_bars": "round-trips", "triads": "round-trips", "newton_starts": "round-trips"}.get(

@@ -9,10 +9,12 @@ import math
 import numpy as np
 import yaml
 
-from analysis.core.figures import Figures, plt
+from analysis.core.figures import Figures, paper_vline, plt
+from analysis.core.targets import paper_value
 from analysis.papers.dyad_triad_synthesis.metrics import METHODS, case, roots, scalars, vectors
 from pipeline.core.runlog import Run
 
+SLUG = "dyad-triad-synthesis"
 ROOT_COLORS = {"trivial": "0.5", "special": "C1", "solution": "C3", "degenerate": "C4"}
 BRANCH_STYLE = {"+1": dict(color="C0", label="assembly +1"), "-1": dict(color="C2", label="assembly −1")}
 
@@ -87,10 +89,11 @@ def table5(runs: list[Run], figures: Figures) -> None:
                 ax.axvline(np.degrees(x), color=color, ls=":", lw=1)
                 ax.text(np.degrees(x), 0.03, f" {label}", rotation=90, fontsize=7,
                         transform=ax.get_xaxis_transform(), color=color)
-            for x in (116, -27):
-                ax.axvline(x, color="k", ls="--", lw=0.8)
+            for end in ("upper", "lower"):
+                x = paper_value(SLUG, f"S2.5.beta2.{end}", "deg")
+                paper_vline(ax, x, label=None, lw=0.8)
                 if not zoom or abs(x) < 35:
-                    ax.text(x, 0.75, f" paper: {x:+d}°", fontsize=7, transform=ax.get_xaxis_transform())
+                    ax.text(x, 0.75, f" paper: {x:+g}°", fontsize=7, transform=ax.get_xaxis_transform())
             ax.axhline(0, color="k", lw=0.5)
             ax.set_xlabel("β2 [deg]")
             if zoom:

@@ -14,10 +14,15 @@ import pandas as pd
 from analysis.core.compute_time import timing_metrics
 from analysis.core.errors import error_stats
 from analysis.core.metrics import MetricTable
+from analysis.core.targets import paper_value
 from pipeline.core.runlog import Run
 from pipeline.papers.dyad_triad_synthesis import burmester
 
+SLUG = "dyad-triad-synthesis"
 PRIME = {"": "", "'": "p"}
+# Table 5's Δ vectors as printed (targets.csv, in the paper's units) -> their target ids
+PRINTED_TABLE5 = {"Δ1": "delta1", "Δ2": "delta2", "Δ3": "delta3", "Δ4": "delta4", "Δ1'": "delta1p",
+                  "Δ2'": "delta2p", "Δ3'": "delta3p"}
 TOL_ON_CURVE = 1e-9          # |implicit condition| below this: the point lies on the curve (a random point: ~1e-2)
 UNIT_CIRCLE = 1e-7           # | |z| − 1 | below this: a complex root is a real rotation
 
@@ -109,7 +114,8 @@ def _table5(run: Run) -> dict[str, tuple[float, str]]:
     add("delta_loop_more_limiting", float(measure["delta"] < measure["delta_prime"]), "bool")
     # the paper against itself: Table 5 as printed closes eqs. (13) and (19) and gives Sec. 2.5's rotation
     unit = run.config["system"]["length_unit"]
-    printed = {k: complex(*v) * unit for k, v in run.config["printed"]["table5"].items()}
+    printed = {name: complex(paper_value(SLUG, f"T5.{key}.re"), paper_value(SLUG, f"T5.{key}.im")) * unit
+               for name, key in PRINTED_TABLE5.items()}
     add("printed.eq13_residual", abs(printed["Δ1"] + printed["Δ2"] + printed["Δ3"] + printed["Δ4"]), "m")
     add("printed.eq19_residual", abs(printed["Δ1'"] + printed["Δ2'"] + printed["Δ3'"] + printed["Δ4"]), "m")
     turn = math.remainder(np.angle(printed["Δ2"]) - np.angle(printed["Δ2'"]), 2 * math.pi)

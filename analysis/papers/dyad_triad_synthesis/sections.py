@@ -1,4 +1,4 @@
-"""Extra report tables of `dyad-triad-synthesis`: what the paper shows only as figures or not at all (the
+"""Report sections of `dyad-triad-synthesis`: what the paper shows only as figures or not at all (the
 roots and dyads of the worked example, the four-bar's defects, the Exudyn runs, the round trips, the solvers'
 compute time). Lengths in the units of Table 4 (the assumption 1 unit = 1 cm), angles in degrees."""
 
@@ -10,13 +10,14 @@ import pandas as pd
 
 from analysis.core.compute_time import compute_time_section, machine_of
 from analysis.core.metrics import metric_value
+from analysis.core.sections import Section, Table
 from analysis.papers.dyad_triad_synthesis.metrics import METHODS
 
 CM = 100.0          # m -> Table 4 units (1 unit = 1 cm, assumed)
 DEG = 180.0 / math.pi
 
 
-def _worked_example(m: pd.DataFrame) -> str:
+def _worked_example(m: pd.DataFrame) -> Section:
     run = m["run_id"].iloc[0]
 
     def v(name: str) -> float:
@@ -42,19 +43,20 @@ def _worked_example(m: pd.DataFrame) -> str:
                             "in all [deg]": v(f"beta2_range.{key}.measure") * DEG}
                            for label, key in (("Δ loop", "delta"), ("Δ' loop", "delta_prime"),
                                               ("both (the six-bar)", "both"))])
-    return ("## The worked example (Sec. 2.5): roots, dyads and the β2 range\n\n"
-            f"Real roots of the two compatibility equations: {v('roots.real'):.0f} (of {v('complex_roots'):.0f} "
+    return Section(
+        "The worked example (Sec. 2.5): roots, dyads and the β2 range",
+        f"Real roots of the two compatibility equations: {v('roots.real'):.0f} (of {v('complex_roots'):.0f} "
             f"complex, {v('complex_roots.real'):.0f} of them on the unit circle); {v('roots.special'):.0f} special "
             f"(β ≡ 0 and β ≡ α), {v('dyads'):.0f} dyads; linear-solve residual ≤ {v('roots.max_residual'):.1e} m. "
             f"The least-squares Burmester solve (no cofactors) finds {v('least_squares.dyads'):.0f} dyads, "
             f"≤ {v('least_squares.max_difference'):.1e} m from these. Table 5 moves by at most "
             f"{v('delta.rounding_spread') * CM:.1e} units when Table 4's inputs move within their printed "
-            "rounding.\n\n" + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".4f")
-            + "\n\nWhere the loops close as β2 turns (the paper reads +116° / −27° off Fig. 12):\n\n"
-            + ranges.to_markdown(index=False, floatfmt=".2f"))
+            "rounding.", Table(pd.DataFrame(rows), ".4f"),
+        "Where the loops close as β2 turns (the paper reads +116° / −27° off Fig. 12):", Table(ranges, ".2f"),
+        category="trajectories")
 
 
-def _defects(m: pd.DataFrame) -> str:
+def _defects(m: pd.DataFrame) -> Section:
     def v(name: str) -> float:
         return metric_value(m, "defects", name)
 
@@ -72,16 +74,16 @@ def _defects(m: pd.DataFrame) -> str:
     ranges = "; ".join(f"driver {d} moves over [{v(f'{d}.range.lo') * DEG:.3f}°, {v(f'{d}.range.hi') * DEG:.3f}°]"
                        f", order of the poses on the circuit {'kept' if v(f'{d}.order_kept') else 'broken'}"
                        for d in "AB")
-    return ("## The four-bar of dyads A and B: defects (closed-form position analysis)\n\n"
-            f"Link lengths: {lengths}. Grashof margin p + q − s − l = {v('grashof_margin') * CM:.3f} "
+    return Section(
+        "The four-bar of dyads A and B: defects (closed-form position analysis)",
+        f"Link lengths: {lengths}. Grashof margin p + q − s − l = {v('grashof_margin') * CM:.3f} "
             f"({'Grashof' if v('grashof_margin') >= 0 else 'non-Grashof: a triple rocker, one circuit'}). {ranges}. "
             "A leg whose poses lie on different assemblies of its driver needs a toggle (a dead centre of that "
             "driver): the linkage cannot be driven through 1→2→3→4→5 by one input (a branch defect), though it "
-            "visits them in order on its single circuit.\n\n" + pd.DataFrame(rows).to_markdown(index=False,
-                                                                                            floatfmt=".3f"))
+            "visits them in order on its single circuit.", Table(pd.DataFrame(rows), ".3f"), category="trajectories")
 
 
-def _exudyn(m: pd.DataFrame) -> str:
+def _exudyn(m: pd.DataFrame) -> Section:
     rows = []
     replay = "replay-1to5"
     if replay in set(m["run_id"]):
@@ -95,18 +97,17 @@ def _exudyn(m: pd.DataFrame) -> str:
                    "max torque [N m]": metric_value(m, r, "torque.max"),
                    "tracer vs closed form, max [m]": metric_value(m, r, "closed_form.position.max"),
                    "joint gap, max [m]": metric_value(m, r, "joint_gap.max")} for r in servo]
-    return ("## Exudyn: the four-bar as a closed loop\n\n"
-            "Kinematic replay 1→5 (crank drives 1→2, rocker 2→5; a coordinate constraint on the driver, updated "
+    return Section(
+        "Exudyn: the four-bar as a closed loop",
+        "Kinematic replay 1→5 (crank drives 1→2, rocker 2→5; a coordinate constraint on the driver, updated "
             f"every 1 ms step): the tracer differs from the closed-form analysis by at most "
             f"{metric_value(m, replay, 'closed_form.position.max'):.1e} m along the whole path, the joints stay "
-            f"closed to {metric_value(m, replay, 'joint_gap.max'):.1e} m.\n\n"
-            + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".2e")
-            + "\n\nServo runs 2→5 (rocker torque, 1 kHz, 4 Hz bandwidth, quintic over 2 s then 0.5 s held, no "
-              "gravity; assumed rods of 1 kg/m):\n\n" + pd.DataFrame(servo_rows).to_markdown(index=False,
-                                                                                         floatfmt=".3g"))
+            f"closed to {metric_value(m, replay, 'joint_gap.max'):.1e} m.", Table(pd.DataFrame(rows), ".2e"),
+        "Servo runs 2→5 (rocker torque, 1 kHz, 4 Hz bandwidth, quintic over 2 s then 0.5 s held, no gravity; "
+        "assumed rods of 1 kg/m):", Table(pd.DataFrame(servo_rows), ".3g"), category="tracking errors")
 
 
-def _round_trips(m: pd.DataFrame) -> str:
+def _round_trips(m: pd.DataFrame) -> Section:
     def v(run: str, name: str) -> float:
         return metric_value(m, run, name)
 
@@ -126,29 +127,30 @@ def _round_trips(m: pd.DataFrame) -> str:
                      "recovered": v(run, "recovered"), "worst relative error": v(run, "vector_error.max_relative"),
                      "cases": v(run, "cases"), "real solutions": f"{v(run, 'solutions.min'):.0f}–"
                                                                  f"{v(run, 'solutions.max'):.0f}"})
-    return ("## Synthetic round trips (spec §8)\n\n"
-            "Build a linkage, sample its precision positions, re-synthesise: the share of cases whose own links "
+    return Section(
+        "Synthetic round trips",
+        "Build a linkage, sample its precision positions, re-synthesise: the share of cases whose own links "
             "come back among the solutions (to 1e-8 of their size). Triads alternate grounded and ungrounded "
             f"(h_j ≠ 0). The 7 PP grid search missed {v('triad-7pp', 'missed_by_grid'):.0f} of the roots that "
-            "Newton from random starts on all three equations found.\n\n"
-            + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".3g"))
+            "Newton from random starts on all three equations found.", Table(pd.DataFrame(rows), ".3g"),
+        category="trajectories")
 
 
-def _compute_time(m: pd.DataFrame, runs: pd.DataFrame) -> str:
+def _compute_time(m: pd.DataFrame, runs: pd.DataFrame) -> list[Section]:
     run = m["run_id"].iloc[0]
     rows = [(f"{method.replace('_', ' ')}", method, "not reported") for method in METHODS]
     found = pd.DataFrame([{"method": method.replace("_", " "),
                            "dyads found (of the sweep's)": metric_value(m, run, f"{method}.found_fraction"),
                            "problems with every dyad": metric_value(m, run, f"{method}.problems_complete")}
                           for method in METHODS])
-    return (compute_time_section("Compute time: three solvers of the dyad in 5 PP (our extension)", m, run, rows,
-                                 machine_of(runs, "compute-time"), unit="ms",
-                                 note=f"Over Table 4 and {metric_value(m, run, 'problems') - 1:.0f} random four-bar "
-                                      "problems. Timings on a shared machine are noisy: medians.")
-            + "\n\n" + found.to_markdown(index=False, floatfmt=".2f"))
+    timing = compute_time_section("Compute time: three solvers of the dyad in 5 PP (our extension)", m, run, rows,
+                                  machine_of(runs, "compute-time"), unit="ms",
+                                  note=f"Over Table 4 and {metric_value(m, run, 'problems') - 1:.0f} random four-bar "
+                                       "problems. Timings on a shared machine are noisy: medians.")
+    return [timing, Section("The three solvers: dyads found", Table(found, ".2f"), category="compute times")]
 
 
-def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]:
+def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]:
     sections = []
     if "table5" in metrics and not metrics["table5"].empty:
         sections.append(_worked_example(metrics["table5"]))
@@ -161,5 +163,5 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
         sections.append(_round_trips(trips))
     ct = metrics.get("compute-time")
     if ct is not None and not ct.empty:
-        sections.append(_compute_time(ct, runs))
+        sections += _compute_time(ct, runs)
     return sections
