@@ -23,31 +23,36 @@ from numba import types
 from numba.extending import get_cython_function_address
 
 from pipeline.papers.cobot_6r_ik import resultant as rs
-from pipeline.papers.cobot_6r_ik.kinematics import ALPHA, CRX10IAL, Geometry, fk_into
+from pipeline.papers.cobot_6r_ik.kinematics import ALPHA, CRX10IAL, Geometry, _link, fk_into
 
 MAX_ROOTS = 16
 MAX_SOLUTIONS = 16   # 8 frame-{4} solutions × 2 twins (Bézout bound of the three quadrics)
 # per-root record columns (Diagnostics.records)
-REC = ("c1_re", "c1_im", "real", "c2", "c3", "p4x", "p4y", "p4z", "pos_err_a", "rot_err_a", "pos_err_b", "rot_err_b",
-       "accepted_a", "accepted_b", "lambda_residual")
-R_C1, R_IM, R_REAL, R_C2, R_C3, R_P4, R_EPA, R_ERA, R_EPB, R_ERB, R_OKA, R_OKB, R_RES = (
-    0, 1, 2, 3, 4, 5, 8, 9, 10, 11, 12, 13, 14)
+# per-root record columns (Diagnostics.records); errors are those of the algebraic candidate, before polishing;
+# accepted: 0 rejected, 1 a new solution, 2 a duplicate of one already found
+REC = ("c1", "c1_imag", "c2", "c3", "p4x", "p4y", "p4z", "pos_err_a", "rot_err_a", "pos_err_b", "rot_err_b",
+       "accepted_a", "accepted_b", "polished_a", "polished_b", "lambda_residual")
+R_C1, R_IM, R_C2, R_C3, R_P4, R_EP, R_ER, R_OK, R_POL, R_RES = 0, 1, 2, 3, 4, 7, 8, 11, 13, 15
 
 
 @dataclass(frozen=True)
 class Tolerances:
     """What the paper does not state (spec §6.2); every value is a config key."""
 
-    imag: float = 1e-6        # a root is a real candidate if |Im c1| ≤ imag·max(1, |c1|): looser than the
-                              # spec's 1e-9 so that a double root split by the eigen-solver is still tried
-    position: float = 1e-8    # m: FK filter, flange position error of an accepted solution
-    rotation: float = 1e-8    # rad: FK filter, flange rotation error
-    duplicate: float = 1e-6   # rad: two solutions are one if every joint differs by less (mod 2π)
+    imag: float = 1e-2        # a root is a real candidate if |Im c1| ≤ imag·max(1, |c1|): far looser than
+                              # the spec's 1e-9, because Λ's near-double roots split into complex pairs
     newton: int = 3           # Newton steps polishing each real root on Λ
+    polish_position: float = 5e-3   # m: a candidate this close to the pose is polished on the pose …
+    polish_rotation: float = 5e-3   # rad: … (Gauss–Newton on the flange pose, geometric Jacobian)
+    pose_newton: int = 4      # Gauss–Newton steps at most (0: accept or reject the algebraic candidate as is)
+    position: float = 1e-9    # m: FK filter, flange position error of an accepted solution (spec: 1e-6 mm)
+    rotation: float = 1e-9    # rad: FK filter, flange rotation error
+    duplicate: float = 1e-6   # rad: two solutions are one if every joint differs by less (mod 2π)
 
     @property
     def array(self) -> np.ndarray:
-        return np.array([self.imag, self.position, self.rotation, self.duplicate, float(self.newton)])
+        return np.array([self.imag, float(self.newton), self.polish_position, self.polish_rotation,
+                         float(self.pose_newton), self.position, self.rotation, self.duplicate])
 
 
 DEFAULT = Tolerances()
@@ -231,7 +236,7 @@ def _joints(R4: np.ndarray, P3: np.ndarray, R6: np.ndarray, d1: float, a2: float
 
 
 @numba.njit(cache=True)
-def _pose_error(q: np.ndarray, geo: np.ndarray, T: np.ndarray, work: np.ndarray) -> tuple[float, float]:
+def pose_error(q: np.ndarray, geo: np.ndarray, T: np.ndarray, work: np.ndarray) -> tuple[float, float]:
     """(position error in m, rotation angle in rad) of FK(q) against T."""
     fk_into(q, geo, work)
     dp = 0.0
@@ -242,6 +247,49 @@ def _pose_error(q: np.ndarray, geo: np.ndarray, T: np.ndarray, work: np.ndarray)
             dr += (work[r, c] - T[r, c]) ** 2
     # ‖R1 − R2‖_F = 2√2 sin(θ/2)
     return np.sqrt(dp), 2.0 * np.arcsin(min(1.0, np.sqrt(dr) / (2.0 * np.sqrt(2.0))))
+
+
+@numba.njit(cache=True)
+def pose_residual(q: np.ndarray, geo: np.ndarray, T: np.ndarray, J: np.ndarray, e: np.ndarray) -> None:
+    """Geometric Jacobian J (6, 6) of the flange at q and the pose error e (6,) = (Δp, rotation vector)
+    still to go from FK(q) to T, both in the base frame."""
+    F = np.eye(4)
+    z = np.empty((6, 3))
+    p = np.empty((6, 3))
+    d = (geo[0], geo[2], geo[3], geo[4], geo[5], geo[6])
+    a = (0.0, geo[1], 0.0, 0.0, 0.0, 0.0)
+    for i in range(6):
+        z[i] = F[:3, 2]
+        p[i] = F[:3, 3]
+        _link(F, q[i], d[i], a[i], ALPHA[i])
+    for i in range(6):
+        r = F[:3, 3] - p[i]
+        J[0, i] = z[i, 1] * r[2] - z[i, 2] * r[1]
+        J[1, i] = z[i, 2] * r[0] - z[i, 0] * r[2]
+        J[2, i] = z[i, 0] * r[1] - z[i, 1] * r[0]
+        J[3, i], J[4, i], J[5, i] = z[i, 0], z[i, 1], z[i, 2]
+    E = T[:3, :3] @ F[:3, :3].T
+    for i in range(3):
+        e[i] = T[i, 3] - F[i, 3]
+    e[3], e[4], e[5] = 0.5 * (E[2, 1] - E[1, 2]), 0.5 * (E[0, 2] - E[2, 0]), 0.5 * (E[1, 0] - E[0, 1])
+
+
+@numba.njit(cache=True)
+def polish_pose(q: np.ndarray, geo: np.ndarray, T: np.ndarray, steps: int, pos_tol: float, rot_tol: float,
+                work: np.ndarray) -> tuple[float, float]:
+    """Gauss–Newton on the flange pose from q (in place); returns the final (position, rotation) error."""
+    ep, er = pose_error(q, geo, T, work)
+    J = np.empty((6, 6))
+    e = np.empty(6)
+    for _ in range(steps):
+        if ep <= pos_tol and er <= rot_tol:
+            break
+        pose_residual(q, geo, T, J, e)
+        q += np.linalg.solve(J, e)
+        for i in range(6):
+            q[i] = _wrap(q[i])
+        ep, er = pose_error(q, geo, T, work)
+    return ep, er
 
 
 @numba.njit(cache=True)
@@ -265,7 +313,6 @@ def solve_pose(T: np.ndarray, geo: np.ndarray, tol: np.ndarray, q_out: np.ndarra
     q = np.empty(6)
     n_sol = 0
     n_cand = 0
-    steps = int(tol[4])
     for k in range(n):
         x = r[k]
         if abs(x.imag) > tol[0] * max(1.0, abs(x.real)):
@@ -273,8 +320,8 @@ def solve_pose(T: np.ndarray, geo: np.ndarray, tol: np.ndarray, q_out: np.ndarra
         rec = records[n_cand]
         rec[:] = np.nan
         rec[R_IM] = x.imag
-        c1 = _polish(lam, x.real, steps)
-        rec[R_C1], rec[R_REAL] = c1, 1.0
+        c1 = _polish(lam, x.real, int(tol[1]))
+        rec[R_C1] = c1
         rec[R_RES] = abs(rs.polyval(lam, c1))
         c2 = _common_c2(psi1, psi2, c1)
         c3 = _c3(f, c1, c2)
@@ -292,24 +339,27 @@ def solve_pose(T: np.ndarray, geo: np.ndarray, tol: np.ndarray, q_out: np.ndarra
         rec[R_C2], rec[R_C3] = c2, c3
         rec[R_P4], rec[R_P4 + 1], rec[R_P4 + 2] = P4[0], P4[1], P4[2]
         for twin in range(2):
-            rec[R_OKA + twin] = 0.0
+            rec[R_OK + twin], rec[R_POL + twin] = 0.0, 0.0
             if not _joints(R4, P3, R6, d1, a2, twin, q):
                 continue
-            ep, er = _pose_error(q, geo, T, work)
-            rec[R_EPA + 2 * twin], rec[R_ERA + 2 * twin] = ep, er
-            if ep > tol[1] or er > tol[2]:
+            ep, er = pose_error(q, geo, T, work)
+            rec[R_EP + 2 * twin], rec[R_ER + 2 * twin] = ep, er
+            if (ep > tol[5] or er > tol[6]) and ep <= tol[2] and er <= tol[3] and tol[4] > 0:
+                ep, er = polish_pose(q, geo, T, int(tol[4]), tol[5], tol[6], work)
+                rec[R_POL + twin] = 1.0
+            if ep > tol[5] or er > tol[6]:
                 continue
             duplicate = False
             for s_ in range(n_sol):
                 same = True
                 for j in range(6):
-                    if abs(_wrap(q_out[s_, j] - q[j])) >= tol[3]:
+                    if abs(_wrap(q_out[s_, j] - q[j])) >= tol[7]:
                         same = False
                         break
                 if same:
                     duplicate = True
                     break
-            rec[R_OKA + twin] = 2.0 if duplicate else 1.0
+            rec[R_OK + twin] = 2.0 if duplicate else 1.0
             if not duplicate and n_sol < MAX_SOLUTIONS:
                 q_out[n_sol] = q
                 n_sol += 1

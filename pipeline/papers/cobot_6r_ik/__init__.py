@@ -1,0 +1,78 @@
+"""`cobot-6r-ik`: Carbonari, Palpacelli, Callegari — Inverse Kinematics of a Class of 6R Collaborative
+Robots with Non-Spherical Wrist (Robotics 2023, 12, 36).
+
+The importable API (SI units, the paper's Table 1 DH; FANUC CRX-10iA/L):
+
+    fk(q) -> (4, 4) or (N, 4, 4)          forward kinematics, eq. (2)
+    ik_all(T) -> (k, 6)                   every solution (k ≤ 16), angles in (−π, π], from Λ(c1) of eq. (25)
+    ik_batch(T (N, 4, 4)) -> (q (N, 16, 6) NaN-padded, counts (N,))
+    ik_diagnose(T) -> Diagnostics         the 16 roots of Λ and what became of each real one (Tables 2–3)
+    twin(q)                               the other configuration sharing frame {4} (q2 / π − q2)
+    cayley(c), cayley_params(R)           eqs. (4)–(6) and their inverse
+
+Every angle within (−π, π] lies inside Table 1's motion ranges (±π, ±π, ±1.5π, ±1.06π, ±π, ±1.25π), so
+no solution is dropped for joint limits.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, OneOf, Range
+from pipeline.papers.cobot_6r_ik import ik
+from pipeline.papers.cobot_6r_ik.ik import DEFAULT, Diagnostics, Tolerances
+from pipeline.papers.cobot_6r_ik.kinematics import CRX10IAL, Geometry, cayley, cayley_params, fk, twin, wrap
+
+__all__ = ["CRX10IAL", "DEFAULT", "Diagnostics", "Geometry", "Tolerances", "cayley", "cayley_params", "fk",
+           "ik_all", "ik_batch", "ik_diagnose", "twin", "wrap"]
+
+
+def ik_all(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT) -> np.ndarray:
+    """Every joint set reaching flange pose T (4, 4): shape (k, 6), rad."""
+    return ik.solve(T, g, tol)
+
+
+def ik_batch(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT) -> tuple[np.ndarray, np.ndarray]:
+    """Many poses in one call: T (N, 4, 4) -> (q (N, 16, 6), NaN rows past counts[i]; counts (N,))."""
+    return ik.solve_batch(T, g, tol)
+
+
+def ik_diagnose(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT) -> Diagnostics:
+    """ik_all with every root of Λ and every candidate it produced."""
+    return ik.diagnose(T, g, tol)
+
+
+def __getattr__(name: str):
+    # The experiments pull in MuJoCo and Hydra; the kinematics API above does not need them.
+    if name == "EXPERIMENTS":
+        from pipeline.papers.cobot_6r_ik import experiments
+
+        return {"tables": experiments.tables, "completeness": experiments.completeness,
+                "compute-time": experiments.compute_time, "trajectory": experiments.trajectory}
+    raise AttributeError(name)
+
+
+_LENGTH = Range(gt=0, le=5.0)   # m
+LIMITS: dict[str, Range | OneOf] = {
+    **{f"system.geometry.{k}": _LENGTH for k in ("d1", "a2", "d2", "d3", "d4", "d5", "d6")},
+    "system.tolerances.imag": Range(ge=0, le=1), "system.tolerances.newton": Range(ge=0, le=20),
+    "system.tolerances.polish_position": Range(ge=0, le=1), "system.tolerances.polish_rotation": Range(ge=0, le=1),
+    "system.tolerances.pose_newton": Range(ge=0, le=20), "system.tolerances.position": Range(gt=0, le=1e-2),
+    "system.tolerances.rotation": Range(gt=0, le=1e-2), "system.tolerances.duplicate": Range(gt=0, le=0.1),
+    "system.dynamics.masses": Range(gt=0, le=100), "system.dynamics.link_radius": Range(gt=0, le=0.5),
+    "system.dynamics.armature": Range(ge=0, le=10), "system.dynamics.damping": Range(ge=0, le=1000),
+    "system.dynamics.torque_limit": Range(gt=0, le=1e4), "system.dynamics.velocity_limit": Range(gt=0, le=100),
+    "scenario.d1_example": _LENGTH, "scenario.poses": Range(ge=1, le=100_000),
+    "scenario.reference_starts": Range(ge=0, le=100_000), "scenario.reference_poses": Range(ge=0, le=10_000),
+    "scenario.warmup": Range(ge=0, le=10_000), "scenario.batch_repeats": Range(ge=1, le=1000),
+    "scenario.peer_poses": Range(ge=0, le=10_000), "scenario.peer_starts": Range(ge=1, le=10_000),
+    "scenario.near_singular_c": Range(gt=0, le=1e12),
+    "scenario.duration": Range(gt=0, le=120), "scenario.ik_dt": Range(gt=0, le=1),
+    "scenario.line.length": Range(gt=0, le=2), "scenario.circle.radius": Range(gt=0, le=1),
+    "execute.dt": Range(gt=0, le=0.01), "execute.bandwidth_hz": Range(gt=0, le=100),
+    "execute.damping_ratio": Range(gt=0, le=10), "execute.log_dt": Range(gt=0, le=1), "execute.tf_dt": Range(gt=0, le=1),
+    "execute.jump_threshold": NON_NEGATIVE, "execute.settle": Range(ge=0, le=10),
+    "scenario.paths": OneOf(("line", "circle")),
+}
+LIMITS["scenario.seed_offset"] = Range(ge=0, le=1e9)
+LIMITS["system.example_d1"] = POSITIVE
