@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, OneOf, Range
+from pipeline.core.experiment import OneOf, Range
 from pipeline.papers.cobot_6r_ik import ik
 from pipeline.papers.cobot_6r_ik.ik import DEFAULT, Diagnostics, Tolerances
 from pipeline.papers.cobot_6r_ik.kinematics import CRX10IAL, Geometry, cayley, cayley_params, fk, twin, wrap
@@ -70,9 +70,9 @@ LIMITS: dict[str, Range | OneOf] = {
     "scenario.duration": Range(gt=0, le=120), "scenario.ik_dt": Range(gt=0, le=1),
     "scenario.line.length": Range(gt=0, le=2), "scenario.circle.radius": Range(gt=0, le=1),
     "execute.dt": Range(gt=0, le=0.01), "execute.bandwidth_hz": Range(gt=0, le=100),
-    "execute.damping_ratio": Range(gt=0, le=10), "execute.log_dt": Range(gt=0, le=1), "execute.tf_dt": Range(gt=0, le=1),
-    "execute.jump_threshold": NON_NEGATIVE, "execute.settle": Range(ge=0, le=10),
-    "scenario.paths": OneOf(("line", "circle")),
+    "execute.damping_ratio": Range(gt=0, le=10), "execute.log_dt": Range(gt=0, le=1),
+    "execute.tf_dt": Range(gt=0, le=1), "execute.jump_threshold": Range(ge=0, le=6.3),
+    "execute.settle": Range(ge=0, le=10), "scenario.paths": OneOf(("line", "circle")),
+    "scenario.q_deg": Range(ge=-360, le=360), "scenario.q_start_deg": Range(ge=-360, le=360),
+    "scenario.line.direction": Range(ge=-1e3, le=1e3), "scenario.circle.normal": Range(ge=-1e3, le=1e3),
 }
-LIMITS["scenario.seed_offset"] = Range(ge=0, le=1e9)
-LIMITS["system.example_d1"] = POSITIVE

@@ -23,7 +23,7 @@ from numba import types
 from numba.extending import get_cython_function_address
 
 from pipeline.papers.cobot_6r_ik import resultant as rs
-from pipeline.papers.cobot_6r_ik.kinematics import ALPHA, CRX10IAL, Geometry, _link, fk_into
+from pipeline.papers.cobot_6r_ik.kinematics import ALPHA, CRX10IAL, Geometry, _link, cayley, fk_into
 
 MAX_ROOTS = 16
 MAX_SOLUTIONS = 16   # 8 frame-{4} solutions × 2 twins (Bézout bound of the three quadrics)
@@ -412,6 +412,22 @@ def diagnose(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT) -> Diagnostic
     k, n, m = solve_pose(T, g.array, tol.array, q, roots, records)
     lam = rs.system(T, g.array)[3]
     return Diagnostics(q[:k].copy(), roots[:n].copy(), records[:m].copy(), lam / np.max(np.abs(lam)))
+
+
+def candidate_joints(T, g: Geometry, c: np.ndarray) -> np.ndarray:
+    """Both joint configurations (2, 6) of the frame {4} given by Cayley parameters c (NaN where undefined),
+    as the solver builds them, before any filter or polishing."""
+    T = _pose(T)
+    c1, c2, c3 = (float(x) for x in c)
+    R4 = np.ascontiguousarray(cayley([c1, c2, c3]))
+    P4 = T[:3, 3] - g.d6 * T[:3, 2] - g.d5 * R4[:, 2]
+    P3 = P4 + g.d4 * R4[:, 1]
+    out = np.full((2, 6), np.nan)
+    for twin in range(2):
+        q = np.empty(6)
+        if _joints(R4, P3, np.ascontiguousarray(T[:3, :3]), g.d1, g.a2, twin, q):
+            out[twin] = q
+    return out
 
 
 def solve_batch(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT) -> tuple[np.ndarray, np.ndarray]:
