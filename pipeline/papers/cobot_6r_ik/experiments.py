@@ -15,7 +15,7 @@ from pipeline.core.runlog import RunWriter, SimulationFailed
 from pipeline.core.timing import time_calls
 from pipeline.papers.cobot_6r_ik import ik, peers, reference
 from pipeline.papers.cobot_6r_ik import resultant as rs
-from pipeline.papers.cobot_6r_ik.kinematics import LIMITS, Geometry, cayley_params, fk, twin, wrap
+from pipeline.papers.cobot_6r_ik.kinematics import LIMITS, Geometry, cayley, cayley_params, fk, twin, wrap
 from pipeline.robotics import dh as dhk
 from pipeline.robotics.transforms import rotation_angle
 
@@ -24,10 +24,12 @@ JOINTS = [f"joint{i}" for i in range(1, 7)]
 Candidate = schemas.define(
     "CobotIkCandidate", "One real root of Λ (eq. 25) taken through back-substitution and the FK filter. Lengths "
     "in m, angles in rad; errors are the algebraic candidate's, before any polishing; accepted: 0 rejected, "
-    "1 a new solution, 2 a duplicate.",
+    "1 a new solution, 2 a duplicate. The *_paper fields follow the paper's own path: c2 from eq. (29), c3 from "
+    "X4 and X6 (which Table 2's c3 imply), P4 from eq. (18).",
     c1="double", c1_imag="double", c2="double", c2_eq29="double", c3="double", c3_pairs="double[]",
     p4="double[]", q_a="double[]", q_b="double[]", pos_err="double[]", rot_err="double[]",
     accepted="double[]", lambda_residual="double",
+    c3_paper="double", p4_paper="double[]", q_paper_a="double[]", q_paper_b="double[]", pos_err_paper="double[]",
 )
 IkSample = schemas.define(
     "CobotIkSample", "Every IK solution of one flange pose (count × 6 joint angles in rad, row-major) and the one "
@@ -100,12 +102,18 @@ def tables(cfg: DictConfig) -> list[Case]:
         for k, rec in enumerate(recs):
             c1, c2, c3 = rec[ik.R_C1], rec[ik.R_C2], rec[ik.R_C3]
             q_ab = ik.candidate_joints(T, g, np.array([c1, c2, c3]))
-            log.log("/ik/candidates", float(k), Candidate, c1=c1, c1_imag=rec[ik.R_IM], c2=c2,
-                    c2_eq29=_c2_eq29(rs.omegas(psi1, c1), rs.omegas(psi2, c1)), c3=c3,
+            c2_29 = _c2_eq29(rs.omegas(psi1, c1), rs.omegas(psi2, c1))
+            c3_46 = _c3_pairs(f, c1, c2_29)[1]
+            paper = np.array([c1, c2_29, c3_46])
+            q_paper = ik.candidate_joints(T, g, paper)
+            p4_paper = T[:3, 3] - g.d6 * T[:3, 2] - g.d5 * cayley(paper)[:, 2]     # eq. (18)
+            log.log("/ik/candidates", float(k), Candidate, c1=c1, c1_imag=rec[ik.R_IM], c2=c2, c2_eq29=c2_29, c3=c3,
                     c3_pairs=_c3_pairs(f, c1, c2), p4=rec[ik.R_P4:ik.R_P4 + 3].tolist(), q_a=q_ab[0].tolist(),
                     q_b=q_ab[1].tolist(), pos_err=[rec[ik.R_EP], rec[ik.R_EP + 2]],
                     rot_err=[rec[ik.R_ER], rec[ik.R_ER + 2]], accepted=[rec[ik.R_OK], rec[ik.R_OK + 1]],
-                    lambda_residual=rec[ik.R_RES])
+                    lambda_residual=rec[ik.R_RES], c3_paper=c3_46, p4_paper=p4_paper.tolist(),
+                    q_paper_a=q_paper[0].tolist(), q_paper_b=q_paper[1].tolist(),
+                    pos_err_paper=[float(np.linalg.norm(fk(x, g)[:3, 3] - T[:3, 3])) for x in q_paper])
         # the solutions, one per second: a replay of the paper's Fig. 3 (Foxglove / Rerun draw /tf)
         t = 1.0 + np.arange(len(d.q))
         log.log_series("/ik/solutions", t, schemas.Reference, name=JOINTS, position=d.q)
