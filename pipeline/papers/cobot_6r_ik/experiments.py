@@ -218,20 +218,20 @@ def _unit(v) -> np.ndarray:
     return v / np.linalg.norm(v)
 
 
-def flange_path(kind: str, spec: DictConfig, T0: np.ndarray, times: np.ndarray, duration: float) -> np.ndarray:
-    """(N, 4, 4) flange poses at constant orientation, min-jerk timed: a line from T0, or a circle through T0."""
+def flange_path(spec: DictConfig, T0: np.ndarray, times: np.ndarray, duration: float) -> np.ndarray:
+    """(N, 4, 4) flange poses at constant orientation, min-jerk timed: a line from T0 along `direction`, or
+    a full circle through T0 whose centre lies `radius` along `center_direction`, starting along `tangent`."""
     s = times / duration
     s = s ** 3 * (10 - 15 * s + 6 * s * s)
     poses = np.tile(T0, (len(times), 1, 1))
-    if kind == "line":
+    if spec.kind == "line":
         poses[:, :3, 3] += (s * spec.length)[:, None] * _unit(spec.direction)
     else:
-        n = _unit(spec.normal)
-        u = _unit(np.cross(n, [0.0, 0.0, 1.0]) if abs(n[2]) < 0.9 else np.cross(n, [1.0, 0.0, 0.0]))
-        v = np.cross(n, u)
-        center = T0[:3, 3] - spec.radius * u
+        w = _unit(spec.center_direction)
+        t = np.asarray(spec.tangent, dtype=float)
+        t = _unit(t - t.dot(w) * w)
         theta = 2 * np.pi * s
-        poses[:, :3, 3] = center + spec.radius * (np.cos(theta)[:, None] * u + np.sin(theta)[:, None] * v)
+        poses[:, :3, 3] = T0[:3, 3] + spec.radius * ((1 - np.cos(theta))[:, None] * w + np.sin(theta)[:, None] * t)
     return poses
 
 
@@ -274,15 +274,15 @@ def trajectory(cfg: DictConfig) -> list[Case]:
     sc, ex, g, tol = cfg.scenario, cfg.execute, geometry(cfg), tolerances(cfg)
     q_start = np.deg2rad(np.asarray(sc.q_start_deg, dtype=float))
 
-    def simulate(log: RunWriter, kind: str) -> None:
+    def simulate(log: RunWriter, name: str) -> None:
         from pipeline.robotics.servo import run_servo
 
         T0 = fk(q_start, g)
         ik_times = np.arange(round(sc.duration / sc.ik_dt) + 1) * sc.ik_dt
-        poses = flange_path(kind, sc[kind], T0, ik_times, sc.duration)
+        poses = flange_path(sc.paths[name], T0, ik_times, sc.duration)
         solutions, counts = ik.solve_batch(poses, g, tol)
         if counts[0] == 0:
-            raise SimulationFailed(f"no IK solution at the start of the {kind} path")
+            raise SimulationFailed(f"no IK solution at the start of the {name} path")
         q_ik, _ = follow_branch(solutions, counts, q_start)
         jumps = np.r_[0.0, np.abs(np.diff(q_ik, axis=0)).max(axis=1)]
         T_ik = fk(wrap(q_ik), g)
@@ -322,4 +322,7 @@ def trajectory(cfg: DictConfig) -> list[Case]:
         log.log_transforms(t_tf, "base", [*(f"link{i}" for i in range(1, 7)), "target"],
                            np.concatenate([frames, target[:, None]], axis=1))
 
-    return [Case(kind, lambda log, k=kind: simulate(log, k)) for kind in sc.paths]
+    unknown = sorted(set(sc.cases) - set(sc.paths))
+    if unknown:
+        raise ValueError(f"scenario.cases {unknown} are not in scenario.paths ({', '.join(sc.paths)})")
+    return [Case(name, lambda log, n=name: simulate(log, n)) for name in sc.cases]
