@@ -24,8 +24,8 @@ JOINTS = [f"joint{i}" for i in range(1, 7)]
 Candidate = schemas.define(
     "CobotIkCandidate", "One real root of Λ (eq. 25) taken through back-substitution and the FK filter. Lengths "
     "in m, angles in rad; errors are the algebraic candidate's, before any polishing; accepted: 0 rejected, "
-    "1 a new solution, 2 a duplicate. The *_paper fields follow the paper's own path: c2 from eq. (29), c3 from "
-    "X4 and X6 (which Table 2's c3 imply), P4 from eq. (18).",
+    "1 a new solution, 2 a duplicate. c2_eq29 is eq. (29)'s c2 at the same c1; the *_paper fields take c3 from "
+    "X4 and X6 (the pair Table 2's c3 imply), then P4 from eq. (18).",
     c1="double", c1_imag="double", c2="double", c2_eq29="double", c3="double", c3_pairs="double[]",
     p4="double[]", q_a="double[]", q_b="double[]", pos_err="double[]", rot_err="double[]",
     accepted="double[]", lambda_residual="double",
@@ -103,8 +103,8 @@ def tables(cfg: DictConfig) -> list[Case]:
             c1, c2, c3 = rec[ik.R_C1], rec[ik.R_C2], rec[ik.R_C3]
             q_ab = ik.candidate_joints(T, g, np.array([c1, c2, c3]))
             c2_29 = _c2_eq29(rs.omegas(psi1, c1), rs.omegas(psi2, c1))
-            c3_46 = _c3_pairs(f, c1, c2_29)[1]
-            paper = np.array([c1, c2_29, c3_46])
+            c3_46 = _c3_pairs(f, c1, c2)[1]
+            paper = np.array([c1, c2, c3_46])
             q_paper = ik.candidate_joints(T, g, paper)
             p4_paper = T[:3, 3] - g.d6 * T[:3, 2] - g.d5 * cayley(paper)[:, 2]     # eq. (18)
             log.log("/ik/candidates", float(k), Candidate, c1=c1, c1_imag=rec[ik.R_IM], c2=c2, c2_eq29=c2_29, c3=c3,
