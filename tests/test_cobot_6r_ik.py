@@ -4,13 +4,21 @@ round trips, the multi-start reference, the paper's own back-substitution path, 
 from __future__ import annotations
 
 import dataclasses
-from math import pi
-
 import numpy as np
 import pytest
 
-from pipeline.papers.cobot_6r_ik import (CRX10IAL, Geometry, cayley, cayley_params, fk, ik_all, ik_batch,
-                                         ik_diagnose, twin, wrap)
+from pipeline.papers.cobot_6r_ik import (
+    CRX10IAL,
+    Geometry,
+    cayley,
+    cayley_params,
+    fk,
+    ik_all,
+    ik_batch,
+    ik_diagnose,
+    twin,
+    wrap,
+)
 from pipeline.papers.cobot_6r_ik import resultant as rs
 from pipeline.papers.cobot_6r_ik.kinematics import LIMITS
 from pipeline.papers.cobot_6r_ik.reference import multistart
@@ -232,4 +240,3 @@ def test_unreachable_pose_has_no_solution():
     T = np.eye(4)
     T[:3, 3] = [3.0, 0.0, 0.5]   # 3 m away: beyond the arm's reach
     assert ik_all(T).shape == (0, 6)
-    assert pi > 0
