@@ -4,6 +4,7 @@ round trips, the multi-start reference, the paper's own back-substitution path, 
 from __future__ import annotations
 
 import dataclasses
+
 import numpy as np
 import pytest
 
