@@ -12,8 +12,8 @@ from .conftest import run_cli
 REDUCED = {   # tables as configured: its targets read the default runs
     "tables": [],
     "completeness": ["scenario.poses=60", "scenario.reference_poses=4", "scenario.reference_starts=100"],
-    "compute-time": ["scenario.poses=40", "scenario.warmup=5", "scenario.batch_repeats=2", "scenario.peer_poses=2",
-                     "scenario.peer_starts=5"],
+    "compute-time": ["scenario.poses=40", "scenario.warmup=5", "scenario.batch_repeats=1", "scenario.batch_chunk=10",
+                     "scenario.peer_poses=2", "scenario.peer_starts=5"],
     "trajectory": ["scenario.cases=[circle]", "scenario.duration=1.0", "scenario.ik_dt=0.01", "execute.settle=0.1"],
 }
 

@@ -65,6 +65,7 @@ LIMITS: dict[str, Range | OneOf] = {
     "scenario.d1_example": _LENGTH, "scenario.poses": Range(ge=1, le=100_000),
     "scenario.reference_starts": Range(ge=0, le=100_000), "scenario.reference_poses": Range(ge=0, le=10_000),
     "scenario.warmup": Range(ge=0, le=10_000), "scenario.batch_repeats": Range(ge=1, le=1000),
+    "scenario.batch_chunk": Range(ge=1, le=10_000),
     "scenario.peer_poses": Range(ge=0, le=10_000), "scenario.peer_starts": Range(ge=1, le=10_000),
     "scenario.near_singular_c": Range(gt=0, le=1e12),
     "scenario.duration": Range(gt=0, le=120), "scenario.ik_dt": Range(gt=0, le=1),

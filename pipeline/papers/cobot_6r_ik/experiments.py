@@ -181,8 +181,12 @@ def compute_time(cfg: DictConfig) -> list[Case]:
         rng = np.random.default_rng(cfg.seed)
         poses = fk(random_joints(rng, int(sc.poses)), g)
         timings = [time_calls("ours", lambda T: ik.solve(T, g, tol), [(T,) for T in poses], warmup=int(sc.warmup))]
-        timings.append(time_calls("ours_batch", lambda: ik.solve_batch(poses, g, tol), [()], warmup=1,
-                                  repeats=int(sc.batch_repeats), items_per_call=len(poses)))
+        # batched in chunks, so that the median per pose is not the mean of a long call that the other jobs
+        # of a shared machine interrupt
+        chunk = int(sc.batch_chunk)
+        chunks = [(poses[i:i + chunk],) for i in range(0, len(poses) - chunk + 1, chunk)]
+        timings.append(time_calls("ours_batch", lambda P: ik.solve_batch(P, g, tol), chunks, warmup=1,
+                                  repeats=int(sc.batch_repeats), items_per_call=chunk))
         ours = [ik.solve(T, g, tol) for T in poses]
         status = {}
         for peer in peers.all_peers(g, int(sc.peer_starts), int(cfg.seed)):

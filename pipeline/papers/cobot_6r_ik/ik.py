@@ -338,17 +338,21 @@ def solve_pose(T: np.ndarray, geo: np.ndarray, tol: np.ndarray, q_out: np.ndarra
             P3[i] = P4[i] + d4 * R4[i, 1]                    # P3 = P4 + R4 (0, d4, 0)
         rec[R_C2], rec[R_C3] = c2, c3
         rec[R_P4], rec[R_P4 + 1], rec[R_P4 + 2] = P4[0], P4[1], P4[2]
+        rec[R_OK], rec[R_OK + 1], rec[R_POL], rec[R_POL + 1] = 0.0, 0.0, 0.0, 0.0
+        n_cand += 1
+        if not _joints(R4, P3, R6, d1, a2, 0, q):
+            continue
+        # the twin (q2 -> π − q2) shares frame {4} and reaches the same flange pose: one FK check serves both
+        ep, er = pose_error(q, geo, T, work)
+        rec[R_EP], rec[R_ER], rec[R_EP + 2], rec[R_ER + 2] = ep, er, ep, er
+        if (ep > tol[5] or er > tol[6]) and ep <= tol[2] and er <= tol[3] and tol[4] > 0:
+            ep, er = polish_pose(q, geo, T, int(tol[4]), tol[5], tol[6], work)
+            rec[R_POL], rec[R_POL + 1] = 1.0, 1.0
+        if ep > tol[5] or er > tol[6]:
+            continue
         for twin in range(2):
-            rec[R_OK + twin], rec[R_POL + twin] = 0.0, 0.0
-            if not _joints(R4, P3, R6, d1, a2, twin, q):
-                continue
-            ep, er = pose_error(q, geo, T, work)
-            rec[R_EP + 2 * twin], rec[R_ER + 2 * twin] = ep, er
-            if (ep > tol[5] or er > tol[6]) and ep <= tol[2] and er <= tol[3] and tol[4] > 0:
-                ep, er = polish_pose(q, geo, T, int(tol[4]), tol[5], tol[6], work)
-                rec[R_POL + twin] = 1.0
-            if ep > tol[5] or er > tol[6]:
-                continue
+            if twin:
+                q[0], q[1], q[2], q[3] = _wrap(q[0] + pi), _wrap(pi - q[1]), _wrap(pi - q[2]), _wrap(q[3] + pi)
             duplicate = False
             for s_ in range(n_sol):
                 same = True
@@ -363,7 +367,6 @@ def solve_pose(T: np.ndarray, geo: np.ndarray, tol: np.ndarray, q_out: np.ndarra
             if not duplicate and n_sol < MAX_SOLUTIONS:
                 q_out[n_sol] = q
                 n_sol += 1
-        n_cand += 1
     return n_sol, n, n_cand
 
 

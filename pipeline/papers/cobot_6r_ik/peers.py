@@ -97,6 +97,9 @@ def ik_geo(g: Geometry = CRX10IAL) -> Peer:
         q = [s for s, _, least_squares in solutions if not least_squares]
         return wrap(np.array(q, dtype=float).reshape(-1, 6))
 
+    R, p = robot.forward_kinematics([0.3, 0.5, 1.0, -0.4, 0.8, 0.2])   # its own FK pose, fed back
+    if not [s for s, _, least_squares in robot.get_ik_sorted(R, p) if not least_squares]:
+        label += " (finds no exact solution of this arm, not even of its own FK pose)"
     return Peer("ik_geo", label, True, prepare, lambda x: robot.get_ik_sorted(*x), convert)
 
 
