@@ -241,3 +241,24 @@ def test_unreachable_pose_has_no_solution():
     T = np.eye(4)
     T[:3, 3] = [3.0, 0.0, 0.5]   # 3 m away: beyond the arm's reach
     assert ik_all(T).shape == (0, 6)
+
+
+def test_genuine_octic_is_the_genuine_factor_of_lambda():
+    # ours: resultant.genuine gives exactly the roots of Λ's genuine octic (SymPy factorisation)
+    T = fk(Q31, EXAMPLE)
+    sp, (c1, *_), _, lam = _symbolic(T, EXAMPLE)
+    f = rs.system(T, EXAMPLE.array)[0]
+    ours = np.sort_complex(np.roots(rs.genuine(f)[::-1]))
+    factors = [sp.Poly(fac, c1).monic() for fac, _ in sp.factor_list(lam.as_expr())[1]
+               if sp.Poly(fac, c1).degree() == 8]
+    exact = [np.sort_complex(np.roots([float(c) for c in p.all_coeffs()])) for p in factors]
+    assert min(np.abs(ours - e).max() for e in exact) < 1e-9
+
+
+def test_octic_finds_every_generating_configuration():
+    q = random_q(300)
+    sols, counts = ik_batch(fk(q), method="octic")
+    for k in range(len(q)):
+        s = sols[k, :counts[k]]
+        assert np.abs(fk(s) - fk(q[k])).max() < 1e-9
+        assert np.abs(wrap(s - q[k])).max(axis=1).min() < 1e-6

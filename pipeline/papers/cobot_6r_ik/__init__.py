@@ -5,6 +5,7 @@ The importable API (SI units, the paper's Table 1 DH; FANUC CRX-10iA/L):
 
     fk(q) -> (4, 4) or (N, 4, 4)          forward kinematics, eq. (2)
     ik_all(T) -> (k, 6)                   every solution (k ≤ 16), angles in (−π, π], from Λ(c1) of eq. (25)
+                                          (method="octic": from Λ's genuine degree-8 factor, ours)
     ik_batch(T (N, 4, 4)) -> (q (N, 16, 6) NaN-padded, counts (N,))
     ik_diagnose(T) -> Diagnostics         the 16 roots of Λ and what became of each real one (Tables 2–3)
     twin(q)                               the other configuration sharing frame {4} (q2 / π − q2)
@@ -27,19 +28,21 @@ __all__ = ["CRX10IAL", "DEFAULT", "Diagnostics", "Geometry", "Tolerances", "cayl
            "ik_all", "ik_batch", "ik_diagnose", "twin", "wrap"]
 
 
-def ik_all(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT) -> np.ndarray:
-    """Every joint set reaching flange pose T (4, 4): shape (k, 6), rad."""
-    return ik.solve(T, g, tol)
+def ik_all(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT, method: str = "lambda16") -> np.ndarray:
+    """Every joint set reaching flange pose T (4, 4): shape (k, 6), rad. method "lambda16" is the paper's
+    Λ with the FK filter; "octic" roots only Λ's genuine factor (ours: faster, better conditioned)."""
+    return ik.solve(T, g, tol, method)
 
 
-def ik_batch(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT) -> tuple[np.ndarray, np.ndarray]:
+def ik_batch(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT,
+             method: str = "lambda16") -> tuple[np.ndarray, np.ndarray]:
     """Many poses in one call: T (N, 4, 4) -> (q (N, 16, 6), NaN rows past counts[i]; counts (N,))."""
-    return ik.solve_batch(T, g, tol)
+    return ik.solve_batch(T, g, tol, method)
 
 
-def ik_diagnose(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT) -> Diagnostics:
-    """ik_all with every root of Λ and every candidate it produced."""
-    return ik.diagnose(T, g, tol)
+def ik_diagnose(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT, method: str = "lambda16") -> Diagnostics:
+    """ik_all with every root of Λ (or G) and every candidate it produced."""
+    return ik.diagnose(T, g, tol, method)
 
 
 def __getattr__(name: str):
@@ -55,7 +58,8 @@ def __getattr__(name: str):
 _LENGTH = Range(gt=0, le=5.0)   # m
 LIMITS: dict[str, Range | OneOf] = {
     **{f"system.geometry.{k}": _LENGTH for k in ("d1", "a2", "d2", "d3", "d4", "d5", "d6")},
-    "system.tolerances.imag": Range(ge=0, le=1), "system.tolerances.newton": Range(ge=0, le=20),
+    "system.method": OneOf(ik.METHODS), "system.tolerances.imag": Range(ge=0, le=1),
+    "system.tolerances.newton": Range(ge=0, le=20),
     "system.tolerances.polish_position": Range(ge=0, le=1), "system.tolerances.polish_rotation": Range(ge=0, le=1),
     "system.tolerances.pose_newton": Range(ge=0, le=20), "system.tolerances.position": Range(gt=0, le=1e-2),
     "system.tolerances.rotation": Range(gt=0, le=1e-2), "system.tolerances.duplicate": Range(gt=0, le=0.1),

@@ -97,6 +97,11 @@ def tables(cfg: DictConfig) -> list[Case]:
                 name=[f"root{k + 1:02d}.{p}" for k in range(len(roots)) for p in ("re", "im")],
                 value=np.column_stack([roots.real, roots.imag]).ravel().tolist())
         log.log("/ik/lambda", 0.0, schemas.Scalars, name=[f"lambda{i:02d}" for i in range(17)], value=d.lam.tolist())
+        octic = ik.diagnose(T, g, tol, "octic").roots   # ours: the roots of Λ's genuine factor alone
+        octic = octic[np.lexsort((-octic.imag, octic.real))]
+        log.log("/ik/octic_roots", 0.0, schemas.Scalars,
+                name=[f"root{k + 1:02d}.{p}" for k in range(len(octic)) for p in ("re", "im")],
+                value=np.column_stack([octic.real, octic.imag]).ravel().tolist())
         f, psi1, psi2, _ = rs.system(T, g.array)
         recs = d.records[np.argsort(d.records[:, ik.R_C1])]
         for k, rec in enumerate(recs):
@@ -141,32 +146,36 @@ def completeness(cfg: DictConfig) -> list[Case]:
         q = random_joints(rng, int(sc.poses))
         poses = fk(q, g)
         c_gen = np.linalg.norm(cayley_params(dhk.frames(dhk.DH.from_config(g.dh), q)[:, 4, :3, :3]), axis=1)
-        rows = np.zeros((len(q), 8))
-        for k, T in enumerate(poses):
-            d = ik.diagnose(T, g, tol)
-            found = np.abs(wrap(d.q - q[k])).max(axis=1) < tol.duplicate if len(d.q) else np.zeros(0, bool)
-            twin_found = (np.abs(wrap(d.q - twin(q[k]))).max(axis=1) < tol.duplicate) if len(d.q) else found
-            acc = d.records[:, ik.R_OK:ik.R_OK + 2]
-            c_sol = np.linalg.norm(cayley_params(dhk.frames(dhk.DH.from_config(g.dh), d.q)[:, 4, :3, :3]), axis=1) \
-                if len(d.q) else np.zeros(1)
-            rows[k] = (len(d.q), float(found.any()), float(twin_found.any()), len(d.roots),
-                       int(np.sum(np.abs(d.roots.imag) <= 1e-9 * np.maximum(1, np.abs(d.roots.real)))),
-                       int((acc == 0).all(axis=1).sum()), c_gen[k], c_sol.max())
         t = np.arange(len(q)) * 1e-3   # one sample per pose, 1 ms apart on the log's time axis
-        log.log_series("/completeness/poses", t, schemas.Scalars, value=rows,
-                       name=["solutions", "generating_found", "twin_found", "roots", "real_roots",
-                             "rejected_roots", "c_generating", "c_max_solution"])
         log.log_series("/completeness/generating", t, schemas.Reference, name=JOINTS, position=q)
+        solutions = {}
+        for method in ik.METHODS:
+            rows = np.zeros((len(q), 7))
+            found_sets = []
+            for k, T in enumerate(poses):
+                d = ik.diagnose(T, g, tol, method)
+                found_sets.append(d.q)
+                hit = np.abs(wrap(d.q - q[k])).max(axis=1) < tol.duplicate if len(d.q) else np.zeros(0, bool)
+                twin_hit = np.abs(wrap(d.q - twin(q[k]))).max(axis=1) < tol.duplicate if len(d.q) else hit
+                acc = d.records[:, ik.R_OK:ik.R_OK + 2]
+                rows[k] = (len(d.q), float(hit.any()), float(twin_hit.any()), len(d.roots),
+                           int(np.sum(np.abs(d.roots.imag) <= 1e-9 * np.maximum(1, np.abs(d.roots.real)))),
+                           int((acc == 0).all(axis=1).sum()), c_gen[k])
+            solutions[method] = found_sets
+            log.log_series(f"/completeness/{method}", t, schemas.Scalars, value=rows,
+                           name=["solutions", "generating_found", "twin_found", "roots", "real_roots",
+                                 "rejected_roots", "c_generating"])
         n_ref = min(int(sc.reference_poses), len(q))
-        ref_rows = np.zeros((n_ref, 4))
+        ref_rows = np.zeros((n_ref, 7))
         ref_rng = np.random.default_rng(cfg.seed + 1)
         for k in range(n_ref):
-            ours = ik.solve(poses[k], g, tol)
             ref = reference.multistart(poses[k], int(sc.reference_starts), ref_rng, g)
-            common, ours_only, ref_only = peers.compare(ours, ref, 1e-6)
-            ref_rows[k] = len(ref), common, ours_only, ref_only
+            ref_rows[k, 0] = len(ref)
+            for m, method in enumerate(ik.METHODS):
+                ref_rows[k, 1 + 3 * m:4 + 3 * m] = peers.compare(solutions[method][k], ref, 1e-6)
         log.log_series("/completeness/reference", t[:n_ref], schemas.Scalars, value=ref_rows,
-                       name=["reference", "common", "ours_only", "reference_only"])
+                       name=["reference", *(f"{m}.{k}" for m in ik.METHODS
+                                            for k in ("common", "ours_only", "reference_only"))])
 
     return [Case("random-poses", simulate)]
 
@@ -180,14 +189,18 @@ def compute_time(cfg: DictConfig) -> list[Case]:
     def simulate(log: RunWriter) -> None:
         rng = np.random.default_rng(cfg.seed)
         poses = fk(random_joints(rng, int(sc.poses)), g)
-        timings = [time_calls("ours", lambda T: ik.solve(T, g, tol), [(T,) for T in poses], warmup=int(sc.warmup))]
         # batched in chunks, so that the median per pose is not the mean of a long call that the other jobs
         # of a shared machine interrupt
         chunk = int(sc.batch_chunk)
         chunks = [(poses[i:i + chunk],) for i in range(0, len(poses) - chunk + 1, chunk)]
-        timings.append(time_calls("ours_batch", lambda P: ik.solve_batch(P, g, tol), chunks, warmup=1,
-                                  repeats=int(sc.batch_repeats), items_per_call=chunk))
+        timings = []
+        for method in ik.METHODS:
+            timings.append(time_calls(method, lambda T, m=method: ik.solve(T, g, tol, m), [(T,) for T in poses],
+                                      warmup=int(sc.warmup)))
+            timings.append(time_calls(f"{method}_batch", lambda P, m=method: ik.solve_batch(P, g, tol, m), chunks,
+                                      warmup=1, repeats=int(sc.batch_repeats), items_per_call=chunk))
         ours = [ik.solve(T, g, tol) for T in poses]
+        octic = [ik.solve(T, g, tol, "octic") for T in poses]
         status = {}
         for peer in peers.all_peers(g, int(sc.peer_starts), int(cfg.seed)):
             status[peer.name] = {"label": peer.label, "available": peer.available, "reason": peer.reason,
@@ -197,10 +210,12 @@ def compute_time(cfg: DictConfig) -> list[Case]:
             n = len(poses) if peer.name == "crx" else min(int(sc.peer_poses), len(poses))
             inputs = [(peer.prepare(T),) for T in poses[:n]]
             timings.append(time_calls(peer.name, peer.call, inputs, warmup=min(int(sc.warmup), n)))
-            rows = np.array([(len(s), *peers.compare(o, s, peer.match_tol))
-                             for o, s in zip(ours[:n], (peer.convert(peer.call(x)) for (x,) in inputs), strict=False)])
+            theirs = [peer.convert(peer.call(x)) for (x,) in inputs]
+            rows = np.array([(len(s), *peers.compare(a, s, peer.match_tol), *peers.compare(b, s, peer.match_tol))
+                             for a, b, s in zip(ours[:n], octic[:n], theirs, strict=True)])
             log.log_series(f"/peers/{peer.name}", np.arange(n) * 1e-3, schemas.Scalars, value=rows.astype(float),
-                           name=["solutions", "common", "ours_only", "peer_only"])
+                           name=["solutions", *(f"{m}.{k}" for m in ik.METHODS
+                                                for k in ("common", "ours_only", "peer_only"))])
         log.metadata["peers"] = json.dumps(status)
         t = 0.0
         for timing in timings:
@@ -209,7 +224,12 @@ def compute_time(cfg: DictConfig) -> list[Case]:
                            seconds=timing.seconds[:, None])
             t = float(times[-1]) + 1e-3
         log.log_series("/ik/solutions", np.arange(len(poses)) * 1e-3, schemas.Scalars,
-                       name=["ours"], value=np.array([len(o) for o in ours], dtype=float)[:, None])
+                       name=["lambda16", "octic"],
+                       value=np.column_stack([[len(o) for o in ours], [len(o) for o in octic]]).astype(float))
+        log.log_series("/ik/octic_vs_lambda16", np.arange(len(poses)) * 1e-3, schemas.Scalars,
+                       name=["common", "lambda16_only", "octic_only"],
+                       value=np.array([peers.compare(a, b, tol.duplicate) for a, b in zip(ours, octic, strict=True)],
+                                      dtype=float))
 
     return [Case("random-poses", simulate)]
 
@@ -284,7 +304,7 @@ def trajectory(cfg: DictConfig) -> list[Case]:
         T0 = fk(q_start, g)
         ik_times = np.arange(round(sc.duration / sc.ik_dt) + 1) * sc.ik_dt
         poses = flange_path(sc.paths[name], T0, ik_times, sc.duration)
-        solutions, counts = ik.solve_batch(poses, g, tol)
+        solutions, counts = ik.solve_batch(poses, g, tol, cfg.system.method)
         if counts[0] == 0:
             raise SimulationFailed(f"no IK solution at the start of the {name} path")
         q_ik, _ = follow_branch(solutions, counts, q_start)

@@ -73,11 +73,11 @@ _SCALE_ONLY = np.array([ord("S")], dtype=np.uint8)
 
 @numba.njit(cache=True)
 def _roots(lam: np.ndarray) -> tuple[np.ndarray, int]:
-    """Roots of Λ (ascending coefficients) as eigenvalues of its balanced companion matrix; leading
-    coefficients below 1e-14 of the largest are dropped (a root at infinity: the Cayley singularity of a
-    half-turn of frame {4})."""
+    """Roots of a polynomial (ascending coefficients, Λ or G) as eigenvalues of its balanced companion
+    matrix; leading coefficients below 1e-14 of the largest are dropped (a root at infinity: the Cayley
+    singularity of a half-turn of frame {4})."""
     scale = np.max(np.abs(lam))
-    n = 16
+    n = lam.shape[0] - 1
     while n > 0 and abs(lam[n]) <= 1e-14 * scale:
         n -= 1
     out = np.empty(MAX_ROOTS, np.complex128)
@@ -111,11 +111,11 @@ def _roots(lam: np.ndarray) -> tuple[np.ndarray, int]:
 
 @numba.njit(cache=True)
 def _polish(lam: np.ndarray, x: float, steps: int) -> float:
-    """Newton on Λ from x; a step is kept only if it lowers |Λ|."""
+    """Newton on the polynomial from x; a step is kept only if it lowers its modulus."""
     fx = abs(rs.polyval(lam, x))
     for _ in range(steps):
         p, dp = 0.0, 0.0
-        for i in range(16, -1, -1):
+        for i in range(lam.shape[0] - 1, -1, -1):
             dp = dp * x + p
             p = p * x + lam[i]
         if dp == 0.0:
@@ -293,10 +293,11 @@ def polish_pose(q: np.ndarray, geo: np.ndarray, T: np.ndarray, steps: int, pos_t
 
 
 @numba.njit(cache=True)
-def solve_pose(T: np.ndarray, geo: np.ndarray, tol: np.ndarray, q_out: np.ndarray, roots: np.ndarray,
+def solve_pose(T: np.ndarray, geo: np.ndarray, tol: np.ndarray, octic: bool, q_out: np.ndarray, roots: np.ndarray,
                records: np.ndarray) -> tuple[int, int, int]:
-    """All solutions of one pose into q_out (16, 6); every root of Λ into roots (16,) and one record per
-    real candidate into records (16, len(REC)). Returns (solutions, roots, real candidates)."""
+    """All solutions of one pose into q_out (16, 6); every root of Λ (octic: of its genuine factor G) into
+    roots (16,) and one record per real candidate into records (16, len(REC)). Returns (solutions, roots,
+    real candidates)."""
     d1, a2, d4, d5, d6 = geo[0], geo[1], geo[4], geo[5], geo[6]
     P6 = T[:3, 3] / a2
     P5 = np.empty(3)
@@ -304,7 +305,7 @@ def solve_pose(T: np.ndarray, geo: np.ndarray, tol: np.ndarray, q_out: np.ndarra
         P5[i] = P6[i] - d6 / a2 * T[i, 2]
     f = rs.phi(P5, P6, d1 / a2, d4 / a2, d5 / a2, 1.0)
     psi1, psi2 = rs.psi(f, 0, 2), rs.psi(f, 1, 2)
-    lam = rs.lam(psi1, psi2)
+    lam = rs.genuine(f) if octic else rs.lam(psi1, psi2)
     lam = lam / np.max(np.abs(lam))
     r, n = _roots(lam)
     roots[:n] = r[:n]
@@ -371,11 +372,12 @@ def solve_pose(T: np.ndarray, geo: np.ndarray, tol: np.ndarray, q_out: np.ndarra
 
 
 @numba.njit(cache=True)
-def solve_many(T: np.ndarray, geo: np.ndarray, tol: np.ndarray, q_out: np.ndarray, counts: np.ndarray) -> None:
+def solve_many(T: np.ndarray, geo: np.ndarray, tol: np.ndarray, octic: bool, q_out: np.ndarray,
+               counts: np.ndarray) -> None:
     roots = np.empty(MAX_ROOTS, np.complex128)
     records = np.empty((MAX_ROOTS, len(REC)))
     for i in range(T.shape[0]):
-        counts[i] = solve_pose(T[i], geo, tol, q_out[i], roots, records)[0]
+        counts[i] = solve_pose(T[i], geo, tol, octic, q_out[i], roots, records)[0]
 
 
 # -- Python API ---------------------------------------------------------------------------------------
@@ -388,7 +390,7 @@ class Diagnostics:
     q: np.ndarray          # (k, 6) accepted solutions, rad
     roots: np.ndarray      # (n,) complex roots of Λ
     records: np.ndarray    # (m, len(REC)) one row per real candidate root, columns REC (SI units)
-    lam: np.ndarray        # (17,) Λ's coefficients, ascending, lengths scaled by a2, normalised to max 1
+    lam: np.ndarray        # Λ's (17) or G's (9) coefficients, ascending, lengths scaled by a2, max 1
 
 
 def _pose(T) -> np.ndarray:
@@ -398,22 +400,34 @@ def _pose(T) -> np.ndarray:
     return T
 
 
-def solve(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT) -> np.ndarray:
-    """Every solution of pose T: (k, 6), k ≤ 16, angles in (−π, π]."""
+METHODS = ("lambda16", "octic")
+
+
+def _octic(method: str) -> bool:
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {', '.join(METHODS)}, not {method!r}")
+    return method == "octic"
+
+
+def solve(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT, method: str = "lambda16") -> np.ndarray:
+    """Every solution of pose T: (k, 6), k ≤ 16, angles in (−π, π]. method: "lambda16" (the paper's Λ, with
+    the FK filter rejecting its extraneous roots) or "octic" (its genuine factor G only, ours)."""
     q = np.empty((MAX_SOLUTIONS, 6))
     roots = np.empty(MAX_ROOTS, np.complex128)
     records = np.empty((MAX_ROOTS, len(REC)))
-    k = solve_pose(_pose(T), g.array, tol.array, q, roots, records)[0]
+    k = solve_pose(_pose(T), g.array, tol.array, _octic(method), q, roots, records)[0]
     return q[:k].copy()
 
 
-def diagnose(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT) -> Diagnostics:
+def diagnose(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT, method: str = "lambda16") -> Diagnostics:
     q = np.empty((MAX_SOLUTIONS, 6))
     roots = np.empty(MAX_ROOTS, np.complex128)
     records = np.empty((MAX_ROOTS, len(REC)))
     T = _pose(T)
-    k, n, m = solve_pose(T, g.array, tol.array, q, roots, records)
-    lam = rs.system(T, g.array)[3]
+    k, n, m = solve_pose(T, g.array, tol.array, _octic(method), q, roots, records)
+    f, _, _, lam = rs.system(T, g.array)
+    if method == "octic":
+        lam = rs.genuine(f)
     return Diagnostics(q[:k].copy(), roots[:n].copy(), records[:m].copy(), lam / np.max(np.abs(lam)))
 
 
@@ -433,12 +447,13 @@ def candidate_joints(T, g: Geometry, c: np.ndarray) -> np.ndarray:
     return out
 
 
-def solve_batch(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT) -> tuple[np.ndarray, np.ndarray]:
+def solve_batch(T, g: Geometry = CRX10IAL, tol: Tolerances = DEFAULT,
+                method: str = "lambda16") -> tuple[np.ndarray, np.ndarray]:
     """Many poses: T (N, 4, 4) -> (q (N, 16, 6) NaN-padded, counts (N,))."""
     T = np.ascontiguousarray(T, dtype=float)
     if T.ndim != 3 or T.shape[1:] != (4, 4) or not np.isfinite(T).all():
         raise ValueError(f"T must be finite 4×4 transforms of shape (N, 4, 4), got {T.shape}")
     q = np.full((len(T), MAX_SOLUTIONS, 6), np.nan)
     counts = np.zeros(len(T), dtype=np.int64)
-    solve_many(T, g.array, tol.array, q, counts)
+    solve_many(T, g.array, tol.array, _octic(method), q, counts)
     return q, counts

@@ -163,6 +163,74 @@ def lam(psi1: np.ndarray, psi2: np.ndarray) -> np.ndarray:
 
 
 @numba.njit(cache=True)
+def genuine(f: np.ndarray) -> np.ndarray:
+    """The genuine octic factor G of Λ (ours, not in the paper), 9 coefficients ascending.
+
+    With L1 = χ5,2·X4 − χ4,2·X5 = α1 c3 + β1 and L2 = χ6,2·X4 − χ4,2·X6 = α2 c3 + β2 (the c3² terms cancel,
+    χ_h,2 being constants), a common root of X4, X5, X6 satisfies Q = α1β2 − α2β1 = 0 (a cubic in c1, c2)
+    and R = X4(c3 = −β1/α1)·α1² = χ4,2β1² − χ4,1α1β1 + χ4,0α1² = 0 (a quartic). Their resultant in c2 has
+    degree 12 and is G·H², H = Res_c2(α1, β1): R vanishes doubly where α1 = β1 = 0 (tests check it against
+    SymPy's factorisation of Λ). Only G's roots are solutions, so no extraneous root is ever found."""
+    a42, a41, a40 = _chi_arrays(f, 0)
+    a52, a51, a50 = _chi_arrays(f, 1)
+    a62, a61, a60 = _chi_arrays(f, 2)
+    al1, al2 = a52 * a41 - a42 * a51, a62 * a41 - a42 * a61      # linear
+    be1, be2 = a52 * a40 - a42 * a50, a62 * a40 - a42 * a60      # quadratic
+    Q = np.zeros((5, 5))
+    _conv2_acc(al1, 1, be2, 2, 1.0, Q)
+    _conv2_acc(al2, 1, be1, 2, -1.0, Q)
+    R = np.zeros((5, 5))
+    _conv2_acc(be1, 2, be1, 2, a42, R)
+    t = np.zeros((3, 3))
+    _conv2_acc(a41, 1, al1, 1, 1.0, t)
+    _conv2_acc(t, 2, be1, 2, -1.0, R)
+    t[:] = 0.0
+    _conv2_acc(al1, 1, al1, 1, 1.0, t)
+    _conv2_acc(a40, 2, t, 2, 1.0, R)
+    P = lam(R, Q)   # det Bez(R, Q) = R's constant leading coefficient × Res_c2(R, Q): degree 12
+    # H = Res_c2(α1, β1) for α1 = A0(c1) + A1 c2, β1 = B0(c1) + B1(c1) c2 + B2 c2²: A1² B0 − A1 A0 B1 + A0² B2
+    A1, B2 = al1[0, 1], be1[0, 2]
+    H = np.zeros(3)
+    for i in range(3):
+        H[i] += A1 * A1 * be1[i, 0]
+    for i in range(2):
+        for k in range(2):
+            H[i + k] += -A1 * al1[i, 0] * be1[k, 1] + B2 * al1[i, 0] * al1[k, 0]
+    H2 = np.zeros(5)
+    _conv_acc(H, 2, H, 2, 1.0, H2)
+    return _divide(P[:13] / np.max(np.abs(P)), H2 / np.max(np.abs(H2)))
+
+
+@numba.njit(cache=True)
+def _divide(P: np.ndarray, D: np.ndarray) -> np.ndarray:
+    """The quotient G of P (13) by D (5), ascending, as the least-squares solution of conv(D, G) = P (Givens
+    QR of the banded 13×9 system): long division from either end loses the roots of G near D's."""
+    A = np.zeros((13, 10))
+    for k in range(9):
+        for j in range(5):
+            A[k + j, k] = D[j]
+    A[:, 9] = P
+    for k in range(9):
+        for i in range(k + 1, min(k + 5, 13)):
+            a, b = A[k, k], A[i, k]
+            if b == 0.0:
+                continue
+            r = np.hypot(a, b)
+            c, s = a / r, b / r
+            for j in range(k, 10):
+                x, y = A[k, j], A[i, j]
+                A[k, j] = c * x + s * y
+                A[i, j] = -s * x + c * y
+    G = np.zeros(9)
+    for k in range(8, -1, -1):
+        acc = A[k, 9]
+        for j in range(k + 1, 9):
+            acc -= A[k, j] * G[j]
+        G[k] = acc / A[k, k]
+    return G
+
+
+@numba.njit(cache=True)
 def polyval(p: np.ndarray, x: float) -> float:
     y = 0.0
     for i in range(p.shape[0] - 1, -1, -1):
