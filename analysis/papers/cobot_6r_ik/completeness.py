@@ -62,10 +62,10 @@ def analyze_completeness(runs: list[Run], figures: Figures) -> pd.DataFrame:
         c = run["/completeness/lambda16"]["value.c_generating"].to_numpy()
         for k, method in enumerate(METHODS):
             f = found_by[method]
-            axes[1].semilogx(c[~f], np.full((~f).sum(), k), "x", color="C3", ms=7)
             axes[1].semilogx(c[f], np.full(f.sum(), k), "|", color="C2", ms=12)
+            axes[1].semilogx(c[~f], np.full((~f).sum(), k) + 0.25, "v", color="C3", ms=7, zorder=3)
         axes[1].plot([], [], "|", color="C2", label="generating joints found")
-        axes[1].plot([], [], "x", color="C3", label="missed")
+        axes[1].plot([], [], "v", color="C3", label="missed")
         axes[1].axvline(near_c, color="k", ls="--", lw=1, label=f"|c| = {near_c:g} (near a half-turn)")
         axes[1].set_yticks(range(len(METHODS)), METHODS)
         axes[1].set_ylim(-0.7, len(METHODS) - 0.3)

@@ -289,7 +289,8 @@ def arm_model(cfg: DictConfig, g: Geometry, q0: np.ndarray) -> str:
 
     def build(kp, kv) -> str:
         return serial_arm("crx10ial_paper_dh", dh, dyn, timestep=ex["dt"], kp=list(kp), kv=list(kv),
-                          radii=list(dyn_cfg.radii), dh_segments=True)
+                          radii=list(dyn_cfg.radii), dh_segments=True,
+                          world_xml='\n    <light pos="1 -1 3" dir="-0.3 0.3 -1" diffuse="0.8 0.8 0.8"/>')
 
     return with_servo_gains(build, q0, ex["bandwidth_hz"], ex["damping_ratio"])
 
