@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pipeline.core.experiment import OneOf, Range
+from pipeline.core.experiment import Budget, Length, OneOf, Range, Rule
 from pipeline.papers.cobot_6r_ik import ik
 from pipeline.papers.cobot_6r_ik.ik import DEFAULT, Diagnostics, Tolerances
 from pipeline.papers.cobot_6r_ik.kinematics import CRX10IAL, Geometry, cayley, cayley_params, fk, twin, wrap
@@ -72,14 +72,36 @@ LIMITS: dict[str, Range | OneOf] = {
     "scenario.batch_chunk": Range(ge=1, le=10_000),
     "scenario.peer_poses": Range(ge=0, le=10_000), "scenario.peer_starts": Range(ge=1, le=10_000),
     "scenario.near_singular_c": Range(gt=0, le=1e12),
-    "scenario.duration": Range(gt=0, le=120), "scenario.ik_dt": Range(gt=0, le=1),
+    "scenario.duration": Range(gt=0, le=120), "scenario.ik_dt": Range(ge=1e-4, le=1),
     "scenario.paths.line.length": Range(gt=0, le=2), "scenario.paths.circle.radius": Range(gt=0, le=1),
     "scenario.paths.circle-branch-end.radius": Range(gt=0, le=1),
     **{f"scenario.paths.{p}.kind": OneOf(("line", "circle")) for p in ("line", "circle", "circle-branch-end")},
-    "scenario.cases": OneOf(("line", "circle", "circle-branch-end")),
-    "execute.dt": Range(gt=0, le=0.01), "execute.bandwidth_hz": Range(gt=0, le=100),
-    "execute.damping_ratio": Range(gt=0, le=10), "execute.log_dt": Range(gt=0, le=1),
-    "execute.tf_dt": Range(gt=0, le=1), "execute.jump_threshold": Range(ge=0, le=6.3),
+    "scenario.cases": (Length(1, 3), OneOf(("line", "circle", "circle-branch-end"))),
+    "execute.dt": Range(ge=1e-4, le=0.01), "execute.bandwidth_hz": Range(gt=0, le=100),
+    "execute.damping_ratio": Range(gt=0, le=10), "execute.log_dt": Range(ge=1e-4, le=1),
+    "execute.tf_dt": Range(ge=1e-4, le=1), "execute.jump_threshold": Range(ge=0, le=6.3),
     "execute.settle": Range(ge=0, le=10),
     "scenario.q_deg": Range(ge=-360, le=360), "scenario.q_start_deg": Range(ge=-360, le=360),
+}
+RULES = (
+    Rule(("execute.dt", "scenario.ik_dt"), lambda dt, ik_dt: dt <= ik_dt,
+         "execute.dt={0:g} s must not exceed scenario.ik_dt={1:g} s: the servo runs at least as often as the IK"),
+    Rule(("execute.log_dt", "execute.dt"), lambda log_dt, dt: log_dt >= dt,
+         "execute.log_dt={0:g} s is shorter than the physics step execute.dt={1:g} s"),
+    Rule(("execute.log_dt", "scenario.duration"), lambda log_dt, T: log_dt <= T / 10,
+         "execute.log_dt={0:g} s leaves fewer than 10 samples of the {1:g} s path"),
+    Rule(("scenario.reference_poses", "scenario.poses"), lambda n_ref, n: n_ref <= n,
+         "scenario.reference_poses={0:g} exceeds scenario.poses={1:g}"),
+)
+BUDGETS = {
+    "tables": Budget("least-squares starts", lambda c: 2 * c.scenario.reference_starts, 1e6,
+                     "fewer scenario.reference_starts"),
+    "completeness": Budget("IK calls and least-squares starts", lambda c: 2 * c.scenario.poses
+                           + c.scenario.reference_poses * c.scenario.reference_starts, 2e7,
+                           "fewer scenario.poses, reference_poses or reference_starts"),
+    "compute-time": Budget("IK calls", lambda c: c.scenario.poses * (6 + 2 * c.scenario.batch_repeats)
+                           + c.scenario.warmup + 1000 * c.scenario.peer_poses * c.scenario.peer_starts, 5e7,
+                           "fewer scenario.poses, batch_repeats, peer_poses or peer_starts"),
+    "trajectory": Budget("physics steps", lambda c: len(c.scenario.cases) * (c.scenario.duration + c.execute.settle)
+                         / c.execute.dt, 5e6, "fewer paths, a shorter scenario.duration or a longer execute.dt"),
 }
