@@ -21,7 +21,7 @@ from pipeline.papers.cobot_6r_ik import (
     wrap,
 )
 from pipeline.papers.cobot_6r_ik import resultant as rs
-from pipeline.papers.cobot_6r_ik.kinematics import LIMITS
+from pipeline.papers.cobot_6r_ik.kinematics import JOINT_LIMITS
 from pipeline.papers.cobot_6r_ik.reference import multistart
 from pipeline.robotics import dh as dhk
 
@@ -31,7 +31,7 @@ Q31 = np.deg2rad([78, 131, 24, 42, -60, -10])   # eq. (31)
 
 
 def random_q(n: int) -> np.ndarray:
-    return RNG.uniform(-LIMITS, LIMITS, (n, 6))
+    return RNG.uniform(-JOINT_LIMITS, JOINT_LIMITS, (n, 6))
 
 
 # -- §8.1-8.3: Cayley map, FK against MuJoCo, twins ----------------------------------------------------

@@ -15,7 +15,7 @@ from pipeline.core.runlog import RunWriter, SimulationFailed
 from pipeline.core.timing import time_calls
 from pipeline.papers.cobot_6r_ik import ik, peers, reference
 from pipeline.papers.cobot_6r_ik import resultant as rs
-from pipeline.papers.cobot_6r_ik.kinematics import LIMITS, Geometry, cayley, cayley_params, fk, twin, wrap
+from pipeline.papers.cobot_6r_ik.kinematics import JOINT_LIMITS, Geometry, cayley, cayley_params, fk, twin, wrap
 from pipeline.robotics import dh as dhk
 from pipeline.robotics.transforms import rotation_angle
 
@@ -50,7 +50,7 @@ def tolerances(cfg: DictConfig) -> ik.Tolerances:
 
 def random_joints(rng: np.random.Generator, n: int) -> np.ndarray:
     """Uniform within Table 1's motion ranges."""
-    return rng.uniform(-LIMITS, LIMITS, (n, 6))
+    return rng.uniform(-JOINT_LIMITS, JOINT_LIMITS, (n, 6))
 
 
 # -- E1: Tables 2-3 ---------------------------------------------------------------------------------

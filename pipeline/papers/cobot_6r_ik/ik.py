@@ -7,7 +7,8 @@ vector of Ω1, Ω2's Bézout matrix, i.e. the common root that eq. (29) solves f
 corrected joint formulas (spec §3.8); then the FK filter that rejects extraneous roots (the paper has
 none; Λ carries an extraneous octic factor, erratum) and de-duplication.
 
-Every root and candidate is also reported (`Diagnostics`) for the paper's Tables 2–3.
+Every root and candidate is also reported (`Diagnostics`) for the paper's Tables 2–3. method="octic" roots
+Λ's genuine factor alone (resultant.genuine, ours) instead of Λ: no extraneous root, half the degree.
 """
 
 from __future__ import annotations

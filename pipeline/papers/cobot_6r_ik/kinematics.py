@@ -45,7 +45,7 @@ class Geometry:
 
 # Table 1 (mm -> m). The numerical example (eqs. 31-33, Table 2) implies d1 = 245.0 mm instead (spec §2).
 CRX10IAL = Geometry(d1=0.2503, a2=0.710, d2=0.2604, d3=0.2604, d4=0.540, d5=0.150, d6=0.160)
-LIMITS = np.array([pi, pi, 1.5 * pi, 1.06 * pi, pi, 1.25 * pi])   # Table 1 motion range, ± rad
+JOINT_LIMITS = np.array([pi, pi, 1.5 * pi, 1.06 * pi, pi, 1.25 * pi])   # Table 1 motion range, ± rad
 
 
 @numba.njit(cache=True)
