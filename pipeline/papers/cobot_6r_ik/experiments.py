@@ -300,7 +300,7 @@ def trajectory(cfg: DictConfig) -> list[Case]:
     q_start = np.deg2rad(np.asarray(sc.q_start_deg, dtype=float))
 
     def simulate(log: RunWriter, name: str) -> None:
-        from pipeline.robotics.servo import run_servo
+        from pipeline.robotics.mjcf import servo_rollout
 
         T0 = fk(q_start, g)
         ik_times = np.arange(round(sc.duration / sc.ik_dt) + 1) * sc.ik_dt
@@ -325,7 +325,7 @@ def trajectory(cfg: DictConfig) -> list[Case]:
                          cfg.system.dynamics.velocity_limit)
         xml = arm_model(cfg, g, q_ref[0])
         log.attach("model.xml", xml, "application/xml")
-        states, sensors = run_servo(xml, q_ref, qd_ref, times)
+        states, sensors = servo_rollout(xml, q_ref, qd_ref, times)
         every = slice(None, None, max(1, round(ex.log_dt / dt)))
         t_state = (times + dt)[every]
         q, qd, tau = states[every, 1:7], states[every, 7:13], sensors[every, :6]
