@@ -54,8 +54,9 @@ def test_cobot_6r_ik_end_to_end(data_dir):
 
 
 def test_bad_input_is_refused_in_one_line(data_dir):
-    for override in ("scenario.poses=1e9", "scenario.cases=[spiral]"):
-        proc = run_cli("pipeline", "experiment=cobot-6r-ik/completeness" if "poses" in override else
-                       "experiment=cobot-6r-ik/trajectory", f"data_dir={data_dir}", override)
-        assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+    for experiment, override in (("completeness", "scenario.poses=1e9"), ("trajectory", "scenario.cases=[spiral]"),
+                                 ("tables", "scenario.q_deg=[90,0]")):          # a joint vector needs 6 angles
+        proc = run_cli("pipeline", f"experiment=cobot-6r-ik/{experiment}", f"data_dir={data_dir}", override)
+        lines = proc.stderr.strip().splitlines()
+        assert proc.returncode == 2 and len(lines) == 1 and override.split("=")[0] in lines[0], proc.stderr
     assert not data_dir.exists()

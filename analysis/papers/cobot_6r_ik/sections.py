@@ -1,4 +1,4 @@
-"""Extra sections of the cobot-6r-ik report page: Table 2 as recomputed, completeness, the compute-time
+"""Report sections of `cobot-6r-ik`: Table 2 as recomputed, completeness, the compute-time
 table beside the peers, the Cartesian paths."""
 
 from __future__ import annotations
@@ -7,13 +7,14 @@ import pandas as pd
 
 from analysis.core.compute_time import machine_of
 from analysis.core.metrics import metric_value
+from analysis.core.sections import Section, Table
 
 
 def _v(frame: pd.DataFrame, run: str, metric: str) -> float:
     return metric_value(frame, run, metric)
 
 
-def _table2(tables: pd.DataFrame) -> str:
+def _table2(tables: pd.DataFrame) -> Section:
     run = "example-d1"
     rows = []
     for k in range(1, 9):
@@ -27,15 +28,17 @@ def _table2(tables: pd.DataFrame) -> str:
                      "P4 [mm]": ", ".join(f"{1e3 * _v(tables, run, f'cand{k}.p4.{a}'):.1f}" for a in "xyz"),
                      "FK error [mm]": 1e3 * _v(tables, run, f"cand{k}.pos_err_a"),
                      "root is": "genuine (2 solutions)" if genuine else "extraneous (rejected)"})
-    return ("## Table 2 recomputed (d1 = 245 mm)\n\nEvery real root of Λ through back-substitution. Our c2 is the "
-            "common root of Ω1, Ω2 (null vector of their Bézout matrix); the paper's eq. (29) gives the same except "
-            "where |c2| is large (c1 = −7.729: −18.981, the printed value, against the exact −19.020). The paper's "
-            "c3 of the extraneous rows follow from X4 and X6, not from the X4, X5 of eq. (30). Extraneous roots "
-            "miss the pose by millimetres to centimetres; the FK filter rejects them.\n\n"
-            + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".4g"))
+    return Section(
+        "Table 2 recomputed (d1 = 245 mm)",
+        "Every real root of Λ through back-substitution. Our c2 is the common root of Ω1, Ω2 (null vector of "
+        "their Bézout matrix); the paper's eq. (29) gives the same except where |c2| is large (c1 = −7.729: "
+        "−18.981, the printed value, against the exact −19.020). The paper's c3 of the extraneous rows follow from "
+        "X4 and X6, not from the X4, X5 of eq. (30). Extraneous roots miss the pose by millimetres to centimetres; "
+        "the FK filter rejects them.",
+        Table(pd.DataFrame(rows)), category="trajectories")
 
 
-def _completeness(c: pd.DataFrame) -> str:
+def _completeness(c: pd.DataFrame) -> Section:
     def v(metric: str) -> float:
         return _v(c, "random-poses", metric)
 
@@ -49,16 +52,17 @@ def _completeness(c: pd.DataFrame) -> str:
              "identical sets [%]": 100 * v(f"{m}.reference.agree_fraction")}
             for m, label in (("lambda16", "the paper's Λ (degree 16) + FK filter"),
                              ("octic", "Λ's genuine octic (ours)"))]
-    return (f"## Completeness on random reachable poses (our extension)\n\n{v('lambda16.poses'):.0f} poses (FK of "
-            f"uniform joints within Table 1's ranges); the multi-start least-squares reference solved "
-            f"{v('reference.poses'):.0f} of them ({v('reference.solutions'):.0f} solutions). "
-            f"{v('lambda16.near_singular.poses'):.0f} poses have |c| of frame {{4}} beyond the near-singular "
-            "threshold. The degree-16 Λ's misses come from its near-double roots (a genuine root next to an "
-            "extraneous one, which double precision splits or shifts) and from near half-turns of frame {4}.\n\n"
-            + pd.DataFrame(rows).to_markdown(index=False, floatfmt=".4g"))
+    return Section(
+        "Completeness on random reachable poses (our extension)",
+        f"{v('lambda16.poses'):.0f} poses (FK of uniform joints within Table 1's ranges); the multi-start "
+        f"least-squares reference solved {v('reference.poses'):.0f} of them ({v('reference.solutions'):.0f} "
+        f"solutions). {v('lambda16.near_singular.poses'):.0f} poses have |c| of frame {{4}} beyond the "
+        "near-singular threshold. The degree-16 Λ's misses come from its near-double roots (a genuine root next to "
+        "an extraneous one, which double precision splits or shifts) and from near half-turns of frame {4}.",
+        Table(pd.DataFrame(rows)), category="trajectories")
 
 
-def _compute_time(ct: pd.DataFrame, runs: pd.DataFrame) -> str:
+def _compute_time(ct: pd.DataFrame, runs: pd.DataFrame) -> Section:
     run = "random-poses"
     peers = {}
     if "label" in ct:
@@ -86,26 +90,28 @@ def _compute_time(ct: pd.DataFrame, runs: pd.DataFrame) -> str:
     table = pd.DataFrame([{"solver": label, "median [µs]": 1e6 * _v(ct, run, f"{n}.median"),
                            "p95 [µs]": 1e6 * _v(ct, run, f"{n}.p95"), "returns": ret, "solution sets vs ours": agree}
                           for label, n, ret, agree in rows])
-    return ("## Compute time beside the peers (our extension; the paper reports no times)\n\n"
-            + table.to_markdown(index=False, floatfmt=".3g")
-            + f"\n\nMeasured in one run on {machine_of(runs, 'compute-time')}, single thread, after warm-up; the "
-            "machine was shared with other jobs while measuring, so the figures are noisy medians. Goal: ≤ 100 µs "
-            "scalar, ≤ 20 µs batched. Λ's coefficients are assembled numerically by convolution (compiled with "
-            "numba), never symbolically at run time.")
+    return Section(
+        "Compute time beside the peers (our extension; the paper reports no times)", Table(table, ".3g"),
+        f"Measured in one run on {machine_of(runs, 'compute-time')}, single thread, after warm-up; the machine "
+        "was shared with other jobs while measuring, so the figures are noisy medians. Goal: ≤ 100 µs scalar, "
+        "≤ 20 µs batched. Λ's coefficients are assembled numerically by convolution (compiled with numba), never "
+        "symbolically at run time.", category="compute times")
 
 
-def _trajectory(tr: pd.DataFrame) -> str:
+def _trajectory(tr: pd.DataFrame) -> Section:
     keep = {"solutions.min": "min solutions", "solutions.max": "max solutions", "max_joint_jump": "max jump [rad]",
             "jumps": "jumps", "max_ik_fk_error": "max IK FK error [m]", "max_joint_error": "max joint err [rad]",
             "max_flange_error": "max flange err [m]", "max_torque_ratio": "max |τ|/τ_max"}
     table = tr[tr["metric"].isin(keep)].pivot(index="run_id", columns="metric", values="value").rename(columns=keep)
-    return ("## Cartesian paths executed in MuJoCo (our extension)\n\nFrom the eq. (32) pose at constant orientation: "
-            "all solutions at 250 Hz, the branch followed by continuity from eq. (31)'s joints, executed by the "
-            "MuJoCo CRX-10iA/L generated from Table 1 (joint PD servo, gravity compensation, 1 kHz).\n\n"
-            + table.reset_index().to_markdown(index=False, floatfmt=".3g"))
+    return Section(
+        "Cartesian paths executed in MuJoCo (our extension)",
+        "From the eq. (32) pose at constant orientation: all solutions at 250 Hz, the branch followed by "
+        "continuity from eq. (31)'s joints, executed by the MuJoCo CRX-10iA/L generated from Table 1 (joint PD "
+        "servo, gravity compensation, 1 kHz).",
+        Table(table, ".3g", index=True), category="tracking errors")
 
 
-def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[str]:
+def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> list[Section]:
     sections = []
     if (t := metrics.get("tables")) is not None and not t.empty and "example-d1" in set(t["run_id"]):
         sections.append(_table2(t))
