@@ -27,7 +27,7 @@ from mcap.records import Chunk
 from mcap.stream_reader import ReadDataStream, get_chunk_data_stream
 from mcap_protobuf.decoder import DecoderFactory
 
-from pipeline.core import files, robot, schemas
+from pipeline.core import files, layouts, robot, schemas
 from pipeline.core.encoding import encode_series
 from pipeline.robotics.transforms import quaternion_wxyz
 
@@ -176,46 +176,58 @@ class RunWriter:
                                          quaternion_wxyz(matrices[..., :3, :3]))
         self._queue(topic, schemas.FrameTransforms).append((times_ns, encoded))
 
-    def log_robot(self, model, times: np.ndarray, qpos: np.ndarray, mocap_pos: np.ndarray | None = None,
-                  mocap_quat: np.ndarray | None = None) -> None:
+    @property
+    def model_xml(self) -> str | None:
+        """The MuJoCo model attached as `model.xml`, if any."""
+        return self._model_xml
+
+    def log_robot(self, times: np.ndarray, qpos: np.ndarray, mocap_pos: np.ndarray | None = None,
+                  mocap_quat: np.ndarray | None = None, model=None) -> None:
         """Draw the simulated robot: its URDF on `/robot_description` (and as attachment `robot.urdf`), its
-        joints on `/joint_states` and its links on `/tf/robot` (pipeline.core.robot), from the MuJoCo model
-        (`MjModel` or MJCF text) and its states `qpos` (N, nq) at `times` (s), mocap bodies' world poses
-        `mocap_pos` (N, nmocap, 3) and `mocap_quat` (N, nmocap, 4, wxyz) if it has any. Drawn at most at
-        robot.VIEW_RATE_HZ."""
+        joints on `/joint_states` and its links on `/tf/robot` (pipeline.core.robot), from MuJoCo states
+        `qpos` (N, nq) at `times` (s) and the world poses of mocap bodies, `mocap_pos` (N or 1, nmocap, 3) and
+        `mocap_quat` (N or 1, nmocap, 4, wxyz; default: as in the model). `model` (`MjModel` or MJCF) defaults
+        to the attached `model.xml`. Call it again to append a later part of the same run; samples are
+        thinned to robot.VIEW_RATE_HZ."""
         import mujoco
 
         from pipeline.robotics.urdf import describe
 
-        if self.robot is not None:
-            raise ValueError("log_robot: this run already draws a robot")
+        model = model if model is not None else self._model_xml
+        if model is None:
+            raise ValueError("log_robot: no model given and no model.xml attached")
         if isinstance(model, str):
             model = mujoco.MjModel.from_xml_string(model)
         times = np.atleast_1d(np.asarray(times, dtype=float))
         keep = robot.thinned(times)
-        mocap = [None if a is None else np.broadcast_to(a, (len(times), *np.shape(a)[-2:]))[keep]
-                 for a in (mocap_pos, mocap_quat)]  # a constant pose may be given once
+        mocap_body = model.body_mocapid >= 0
+        defaults = (model.body_pos[mocap_body], model.body_quat[mocap_body])
+        mocap = [np.broadcast_to(default if a is None else a, (len(times), model.nmocap, default.shape[1]))[keep]
+                 for a, default in zip((mocap_pos, mocap_quat), defaults, strict=True)]
         description = describe(model)
+        if self.robot is None:
+            self.robot = description
+            urdf = description.urdf()
+            self.attach(robot.URDF_ATTACHMENT, urdf, "application/xml")
+            first = seconds_to_ns(times[:1])
+            self._queue(robot.ROBOT_DESCRIPTION, robot.ROS2_STRING).append((first, [robot.ros2_string(urdf)]))
+            fixed = description.fixed
+            if fixed:
+                self._queue(robot.ROBOT_TF, schemas.FrameTransforms).append((first, robot.frame_transforms(
+                    first, [j.parent for j in fixed], [j.child for j in fixed],
+                    np.stack([j.origin.p for j in fixed])[None], np.stack([j.origin.q for j in fixed])[None])))
+        elif self.robot.urdf() != description.urdf():
+            raise ValueError("log_robot: a run draws one robot; this model differs from the first one")
+        if not description.movable:
+            return
         positions = description.joint_positions(np.atleast_2d(qpos)[keep], *mocap)
         times_ns = seconds_to_ns(times[keep])
-        urdf = description.urdf()
-        self._queue(robot.ROBOT_DESCRIPTION, robot.ROS2_STRING).append(
-            (times_ns[:1], [robot.ros2_string(urdf)]))
-        self.attach(robot.URDF_ATTACHMENT, urdf, "application/xml")
-        names = description.joint_names
-        if names:
-            self._queue(robot.JOINT_STATES, schemas.JointStates).append(
-                (times_ns, robot.joint_states(times_ns, names, positions)))
-            trans, quats = description.transforms(positions)
-            self._queue(robot.ROBOT_TF, schemas.FrameTransforms).append((times_ns, robot.frame_transforms(
-                times_ns, [j.parent for j in description.movable], [j.child for j in description.movable],
-                trans, quats)))
-        if description.fixed:
-            fixed = description.fixed
-            self._queue(robot.ROBOT_TF, schemas.FrameTransforms).append((times_ns[:1], robot.frame_transforms(
-                times_ns[:1], [j.parent for j in fixed], [j.child for j in fixed],
-                np.stack([j.origin.p for j in fixed])[None], np.stack([j.origin.q for j in fixed])[None])))
-        self.robot = description
+        self._queue(robot.JOINT_STATES, schemas.JointStates).append(
+            (times_ns, robot.joint_states(times_ns, description.joint_names, positions)))
+        trans, quats = description.transforms(positions)
+        self._queue(robot.ROBOT_TF, schemas.FrameTransforms).append((times_ns, robot.frame_transforms(
+            times_ns, [j.parent for j in description.movable], [j.child for j in description.movable],
+            trans, quats)))
 
     def _robot_from_joint_state(self) -> None:
         """A run that attached its MuJoCo model and logged `/joint_state` under the model's joint names gets
@@ -237,7 +249,7 @@ class RunWriter:
         qpos = np.tile(model.qpos0, (len(times), 1))
         for j, name in enumerate(joints):
             qpos[:, model.jnt_qposadr[j]] = position[:, columns[name]]
-        self.log_robot(model, times, qpos)
+        self.log_robot(times, qpos, model=model)
 
     def attach(self, name: str, data: bytes | str, media_type: str) -> None:
         if name == MODEL_ATTACHMENT:
@@ -278,6 +290,9 @@ class RunWriter:
         """Record the status, finish the file and publish it under its final name."""
         if status == "ok":
             self._robot_from_joint_state()
+        if self._pending:
+            self.attach(layouts.LAYOUT_ATTACHMENT, layouts.foxglove_layout(self._pending, self.metadata.get("slug")),
+                        "application/json")
         self._flush_topics()
         self._writer.write_metadata(METADATA_NAME, {**self.metadata, "status": status})
         self._writer.close()

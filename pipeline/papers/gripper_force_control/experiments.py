@@ -50,6 +50,7 @@ def run_plant(log: RunWriter, cfg: DictConfig, p: Gripper, s: Schedule, start: S
         tf_every = max(1, round(cfg.tf_dt / p.dt))
         trace, poses = sim.simulate(s, start, log_every, settle=cfg.mujoco.settle, tf_every=tf_every)
         log.log_transforms(s.t[::tf_every], "world", list(FRAMES), poses)
+        log.log_robot(s.t[::tf_every], np.array(sim.states))
     elif plant == "lumped":
         trace = lumped.simulate(p, s, start, log_every)
     else:
