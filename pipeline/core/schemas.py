@@ -10,6 +10,7 @@ A paper that needs a record the common schemas cannot hold declares it with `def
 
 from __future__ import annotations
 
+from foxglove_schemas_protobuf.ArrowPrimitive_pb2 import ArrowPrimitive
 from foxglove_schemas_protobuf.Color_pb2 import Color
 from foxglove_schemas_protobuf.CylinderPrimitive_pb2 import CylinderPrimitive
 from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
@@ -119,9 +120,27 @@ def for_topic(topic: str) -> type[Message] | None:
     return None
 
 
-__all__ = ["TOPICS", "Color", "CylinderPrimitive", "FrameTransform", "FrameTransforms", "JointStates", "Point3", "Pose",
-           "PosesInFrame", "Quaternion", "SceneEntity", "SceneUpdate", "SpherePrimitive", "TriangleListPrimitive",
-           "Vector3", "define", "for_topic", "stamp"]
+__all__ = [
+    "TOPICS",
+    "ArrowPrimitive",
+    "Color",
+    "CylinderPrimitive",
+    "FrameTransform",
+    "FrameTransforms",
+    "JointStates",
+    "Point3",
+    "Pose",
+    "PosesInFrame",
+    "Quaternion",
+    "SceneEntity",
+    "SceneUpdate",
+    "SpherePrimitive",
+    "TriangleListPrimitive",
+    "Vector3",
+    "define",
+    "for_topic",
+    "stamp",
+]
 
 
 def stamp(t_ns: int) -> timestamp_pb2.Timestamp:
