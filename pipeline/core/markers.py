@@ -36,3 +36,22 @@ def height_field(name: str, x: np.ndarray, y: np.ndarray, z: np.ndarray, frame: 
     mesh = schemas.TriangleListPrimitive(pose=schemas.Pose(orientation=schemas.Quaternion(w=1.0)), points=points,
                                          color=_color(color), indices=triangles.ravel().tolist())
     return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True, triangles=[mesh])
+
+
+def arrow(name: str, frame: str, vector: Sequence[float], color: Sequence[float], scale: float = 1.0,
+          diameter: float = 0.004) -> schemas.SceneEntity:
+    """An arrow from the origin of /tf frame `frame` along `vector` (in that frame) times `scale` (a force in
+    N drawn at `scale` m/N): Foxglove's ArrowPrimitive points along +x of its pose, so the pose turns x onto it."""
+    v = np.asarray(vector, dtype=float) * scale
+    length = float(np.linalg.norm(v))
+    x = np.array([1.0, 0.0, 0.0])
+    axis = np.cross(x, v / length) if length > 0 else np.zeros(3)
+    sin, cos = float(np.linalg.norm(axis)), float(x @ v / length) if length > 0 else 1.0
+    half = 0.5 * np.arctan2(sin, cos)
+    axis = axis / sin if sin > 1e-12 else np.array([0.0, 0.0, 1.0])
+    q = schemas.Quaternion(w=np.cos(half), x=axis[0] * np.sin(half), y=axis[1] * np.sin(half),
+                           z=axis[2] * np.sin(half))
+    head = min(0.3 * length, 4 * diameter)
+    return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True, arrows=[schemas.ArrowPrimitive(
+        pose=schemas.Pose(orientation=q), shaft_length=length - head, shaft_diameter=diameter,
+        head_length=head, head_diameter=2.5 * diameter, color=_color(color))])

@@ -65,6 +65,7 @@ def log_trajectory(log: RunWriter, cfg: DictConfig, chain: ch.Chain, traj: Traje
     tf = every(cfg, cfg.system.logging.tf_dt)
     log.log_transforms(traj.t[tf], "world", [f"tip{i + 1}" for i in range(chain.n)],
                        ch.pose_matrices(chain, traj.q[tf]))
+    log.log_robot(traj.t[tf], traj.q[tf])  # the attached MuJoCo chain: its qpos are the paper's q
 
 
 def _pd_gains(spec: DictConfig, n: int) -> Gains:
@@ -246,6 +247,7 @@ def checks(cfg: DictConfig) -> list[Case]:
         log.log_series("/joint_state", traj.t[logged], name=names, position=traj.q[logged], velocity=traj.qd[logged])
         log.log_series("/joint_state/mujoco", traj.t[logged], schemas.JointState, name=names, position=q_mj[logged],
                        velocity=qd_mj[logged])
+        log.log_robot(traj.t[logged], q_mj[logged])
         for integrator in sc.energy_integrators:
             free = simulate(chain.undamped(), q0, np.zeros(chain.n), Gains.free(chain.n), dt, sc.energy_duration,
                             integrator=integrator)
