@@ -175,7 +175,7 @@ def _target_rows(part: pd.DataFrame, data_dir: Path, report_dir: Path) -> list[d
             "status_rank": STATUS_RANK.get(t.status, 99), "cause": t.cause, "quantity": t.quantity, "where": t.where,
             "paper": f"{OP_SIGN.get(t.op, '')}{paper}" if paper != "" else "", "paper_sort": paper,
             "pipeline": _fmt(t.pipeline_value), "pipeline_sort": _fmt(t.pipeline_value),
-            "band": _band_text(t), "band_anchor": anchor("band", t.band) if _band_text(t) else "",
+            "band": _band_text(t), "band_anchor": anchor("band", t.band) if getattr(t, "band", "") else "",
             "deviation": _signed(t.deviation), "relative": _signed(t.relative_deviation, relative=True),
             "relative_sort": "" if math.isnan(t.relative_deviation) else f"{abs(t.relative_deviation):.6g}",
             "unit": t.unit, "tolerance": t.tolerance, "basis": t.basis, "mode": t.mode, "note": t.note,
@@ -191,7 +191,7 @@ def _band_text(t) -> str:
         return ""
     if math.isnan(t.band_min):
         return "not run"
-    return f"[{_fmt(t.band_min)}, {_fmt(t.band_max)}]"
+    return f"[{t.band_min:.4g}, {t.band_max:.4g}]"
 
 
 def band_entries(info: dict, evaluated: pd.DataFrame) -> list[dict]:
