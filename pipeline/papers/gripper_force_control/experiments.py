@@ -118,6 +118,8 @@ def force_sag(cfg: DictConfig) -> list[Case]:
 
     cases = []
     for name, case in sc.cases.items():
+        if case is None:   # dropped by an override (a band sweeps only the cases its parameter acts on)
+            continue
         p = _case_gripper(cfg, case.friction, case.feedforward)
         cases += [Case(f"{name}-{plant}", lambda log, p=p, plant=plant: simulate(log, p, plant)) for plant in sc.plants]
     for form in sc.forms:   # the printed coupling factor / eq. (9) gains, ideal case
