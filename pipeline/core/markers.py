@@ -1,7 +1,7 @@
 """Shapes to draw on `/markers` (Foxglove SceneUpdate): Foxglove's 3D panel renders them natively, and
 `python -m analysis.view` draws them in Rerun. An entity lives in a /tf frame and moves with it: spheres on
-frames, capsules, cones and rods between points, line strips (paths), height fields (terrain), and a generated
-MuJoCo model drawn from its own geoms (`mujoco_geoms`)."""
+frames, capsules, cones and rods between points, arrows (forces), line strips (paths), height fields (terrain),
+and a generated MuJoCo model drawn from its own geoms (`mujoco_geoms`)."""
 
 from __future__ import annotations
 
@@ -46,12 +46,17 @@ def _pose(position: Sequence[float], quat_wxyz: Sequence[float] = (1.0, 0.0, 0.0
                         orientation=schemas.Quaternion(w=w, x=x, y=y, z=z))
 
 
-def _z_onto(direction: np.ndarray) -> tuple[float, float, float, float]:
-    """The rotation (w, x, y, z) taking +z onto `direction` (Foxglove cylinders stand along their local z)."""
-    d = np.asarray(direction, dtype=float) / np.linalg.norm(direction)
-    w, (x, y, z) = 1.0 + d[2], np.cross([0.0, 0.0, 1.0], d)
-    if w < 1e-12:  # pointing down: half a turn about x
-        return 0.0, 1.0, 0.0, 0.0
+def _onto(axis: Sequence[float], direction: Sequence[float]) -> tuple[float, float, float, float]:
+    """The shortest rotation (w, x, y, z) taking the unit `axis` onto `direction` (Foxglove cylinders stand along
+    their local z, arrows along their local x); the identity for a zero direction."""
+    a, d = np.asarray(axis, dtype=float), np.asarray(direction, dtype=float)
+    length = np.linalg.norm(d)
+    if length == 0:
+        return 1.0, 0.0, 0.0, 0.0
+    w, (x, y, z) = 1.0 + a @ d / length, np.cross(a, d / length)
+    if w < 1e-12:  # opposite: half a turn about any axis perpendicular to `axis`
+        x, y, z = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
+        w = 0.0
     n = np.sqrt(w * w + x * x + y * y + z * z)
     return w / n, x / n, y / n, z / n
 
@@ -61,7 +66,7 @@ def _cylinder(start, end, radius_start: float, radius_end: float, color) -> sche
     start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
     widest = max(radius_start, radius_end)
     return schemas.CylinderPrimitive(
-        pose=_pose((start + end) / 2, _z_onto(end - start)), color=_color(color),
+        pose=_pose((start + end) / 2, _onto((0.0, 0.0, 1.0), end - start)), color=_color(color),
         size=schemas.Vector3(x=2 * widest, y=2 * widest, z=float(np.linalg.norm(end - start))),
         bottom_scale=radius_start / widest, top_scale=radius_end / widest)
 
@@ -106,6 +111,18 @@ def line_strip(name: str, points: np.ndarray, frame: str = "world", thickness: f
                                  pose=_pose((0.0, 0.0, 0.0)),
                                  points=[schemas.Point3(x=x, y=y, z=z) for x, y, z in np.asarray(points).tolist()])
     return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True, lines=[line])
+
+
+def arrow(name: str, frame: str, vector: Sequence[float], color: Sequence[float], scale: float = 1.0,
+          diameter: float = 0.004) -> schemas.SceneEntity:
+    """An arrow from the origin of /tf frame `frame` along `vector` (in that frame) times `scale` (a force in
+    N drawn at `scale` m/N): Foxglove's ArrowPrimitive points along +x of its pose, so the pose turns x onto it."""
+    v = np.asarray(vector, dtype=float) * scale
+    length = float(np.linalg.norm(v))
+    head = min(0.3 * length, 4 * diameter)
+    return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True, arrows=[schemas.ArrowPrimitive(
+        pose=_pose((0.0, 0.0, 0.0), _onto((1.0, 0.0, 0.0), v)), shaft_length=length - head, shaft_diameter=diameter,
+        head_length=head, head_diameter=2.5 * diameter, color=_color(color))])
 
 
 def _z_axis(quat_wxyz: Sequence[float]) -> np.ndarray:
