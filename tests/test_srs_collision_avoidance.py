@@ -144,13 +144,18 @@ def test_filter_step_response_is_exact_and_matches_lfilter():
 
 
 def test_closest_points_of_segments_match_brute_force():
-    A, B, C, D = (RNG.normal(size=(200, 3)) for _ in range(4))
+    rng = np.random.default_rng(7)   # its own stream: the shared one depends on which tests ran before
+    A, B, C, D = (rng.normal(size=(200, 3)) for _ in range(4))
     P, Q = closest_on_segments(A, B, C, D)
     s = np.linspace(0, 1, 401)
     grid = np.linalg.norm((A[:, None, None] + s[None, :, None, None] * (B - A)[:, None, None])
                           - (C[:, None, None] + s[None, None, :, None] * (D - C)[:, None, None]), axis=-1)
-    assert np.all(np.linalg.norm(P - Q, axis=1) <= grid.min(axis=(1, 2)) + 1e-12)
-    assert np.abs(np.linalg.norm(P - Q, axis=1) - grid.min(axis=(1, 2))).max() < 2e-4
+    ours, sampled = np.linalg.norm(P - Q, axis=1), grid.min(axis=(1, 2))
+    assert np.all(ours <= sampled + 1e-12)
+    # the distance is Lipschitz in (s, t) with constant |AB| + |CD|: the grid's minimum lies within half a step of
+    # the true one times that constant (the brute force can be that far off where the minimum sits on an edge)
+    bound = (s[1] / 2) * (np.linalg.norm(B - A, axis=1) + np.linalg.norm(D - C, axis=1))
+    assert np.all(sampled - ours <= bound)
 
 
 def test_safety_margin_matches_sampled_cones():
