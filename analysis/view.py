@@ -6,7 +6,8 @@
 Rerun also opens the .mcap directly (`rerun <run>.mcap`): it draws /tf and decodes every other channel as
 queryable fields. This converter adds what reflection cannot: every numeric column as a time series on a
 `sim_time` timeline, the /tf frames as a 3-D skeleton (frames joined in the order they are logged), and the
-spheres and cylinders of `/markers` (Foxglove SceneUpdate) drawn in the /tf frame each entity names.
+spheres, cylinders, boxes, lines and meshes of `/markers` (Foxglove SceneUpdate) drawn in the /tf frame each
+entity names.
 """
 
 from __future__ import annotations
@@ -44,8 +45,8 @@ def _rgba(color) -> list[float]:
 
 
 def _log_markers(rec: rr.RecordingStream, run_path: Path) -> None:
-    """SceneUpdate spheres, cylinders and triangle meshes under world/<frame_id>/<entity id>: they move with
-    that /tf frame."""
+    """SceneUpdate spheres, cylinders, cubes, line strips and triangle meshes under world/<frame_id>/<entity id>:
+    they move with that /tf frame."""
     with open(run_path, "rb") as f:
         reader = make_reader(f, decoder_factories=[DecoderFactory()])
         for _schema, _channel, message, update in reader.iter_decoded_messages(topics=[MARKERS]):
@@ -65,6 +66,19 @@ def _log_markers(rec: rr.RecordingStream, run_path: Path) -> None:
                         quaternions=[[x.pose.orientation.x, x.pose.orientation.y, x.pose.orientation.z,
                                       x.pose.orientation.w] for x in c],
                         colors=[_rgba(x.color) for x in c]))
+                if entity.cubes:
+                    c = entity.cubes
+                    rec.log(f"{path}/cubes", rr.Boxes3D(
+                        centers=[[x.pose.position.x, x.pose.position.y, x.pose.position.z] for x in c],
+                        half_sizes=[[x.size.x / 2, x.size.y / 2, x.size.z / 2] for x in c],
+                        quaternions=[[x.pose.orientation.x, x.pose.orientation.y, x.pose.orientation.z,
+                                      x.pose.orientation.w] for x in c],
+                        colors=[_rgba(x.color) for x in c], fill_mode="solid"))
+                if entity.lines:
+                    rec.log(f"{path}/lines", rr.LineStrips3D(
+                        [[[p.x, p.y, p.z] for p in line.points] for line in entity.lines],
+                        radii=[line.thickness / 2 for line in entity.lines],
+                        colors=[_rgba(line.color) for line in entity.lines]))
                 for k, mesh in enumerate(entity.triangles):
                     rec.log(f"{path}/triangles{k}", rr.Mesh3D(
                         vertex_positions=[[p.x, p.y, p.z] for p in mesh.points],
