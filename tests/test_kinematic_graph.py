@@ -337,3 +337,13 @@ def test_bad_search_input_is_refused(override):
     with pytest.raises(BadInput) as err:
         preflight(["experiment=kinematic-graph/search", override])
     assert len(str(err.value)) < 300 and "\n" not in str(err.value)
+
+
+def test_a_grid_too_large_is_a_failed_run_before_anything_is_built():
+    from pipeline.core.checks import compose_config
+    from pipeline.core.runlog import SimulationFailed
+    from pipeline.papers.kinematic_graph import experiments as kx
+
+    cfg = compose_config(["experiment=kinematic-graph/spatial", "graph.c_res_deg=0.5"])
+    with pytest.raises(SimulationFailed, match="coarser C_res"):
+        kx.world_of(cfg, "puma")

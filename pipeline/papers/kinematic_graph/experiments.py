@@ -93,9 +93,18 @@ def _world(arm_name: str, node_yaml: str, c_res: float, t_res: float, limit_fact
                  limit_factor), TaskSpacePlanner(kg, limit_factor), mu_max, build_seconds)
 
 
+def _size_check(arm: RegionalArm, c_res: float) -> None:
+    """A grid too large for memory is a failed run with its reason, before anything is built."""
+    try:
+        kgraph.check_size(arm, c_res)
+    except ValueError as err:
+        raise SimulationFailed(str(err)) from None
+
+
 def world_of(cfg: DictConfig, arm_name: str) -> World:
     import yaml
 
+    _size_check(arm_of(cfg, arm_name), math.radians(cfg.graph.c_res_deg))
     return _world(arm_name, yaml.safe_dump(arm_node(cfg, arm_name)), math.radians(cfg.graph.c_res_deg),
                   float(cfg.graph.t_res), float(cfg.search.limit_factor))
 
@@ -192,14 +201,14 @@ def path_record(world: World, scene: Scene, joints: np.ndarray | None, plan: Pla
     arm = world.arm
     steps = np.diff(joints, axis=0)
     mu = arm.manipulability(joints[1:])
-    clearance = scene.checker.min_clearance(dense(joints, step), 1.0) if len(scene.boxes) else np.array([np.inf])
+    # the path's clearance to the obstacles (NaN without obstacles): the dense joint path, not only its vertices
+    clearance = float(scene.checker.min_clearance(dense(joints, step), 1.0).min()) if len(scene.boxes) else nan
     positions = arm.position(joints)
     record.update(t_length_m=float(np.linalg.norm(np.diff(positions, axis=0), axis=1).sum()),
                   min_base_distance_m=float(np.linalg.norm(positions[:, :2], axis=1).min()),
                   c_length_rad=float(np.linalg.norm(steps, axis=1).sum()),
                   max_step_rad=float(np.abs(steps).max()) if len(steps) else 0.0, min_mu=float(mu.min()),
-                  mean_mu=float(mu.mean()), min_clearance_m=float(clearance.min()),
-                  collision_free=bool(clearance.min() >= 0.0))
+                  mean_mu=float(mu.mean()), min_clearance_m=clearance, collision_free=not clearance < 0.0)
     return record
 
 
@@ -228,6 +237,7 @@ def table1(cfg: DictConfig) -> list[Case]:
         records, stages = [], []
         for c_deg in sc.c_res_deg:
             c_res = math.radians(c_deg)
+            _size_check(arm, c_res)
             sampled = kgraph.sample(arm, c_res)
             for t_res in sc.t_res:
                 graph = kgraph.build(arm, c_res, t_res, sampled)

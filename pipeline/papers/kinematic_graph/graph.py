@@ -15,6 +15,7 @@ Vertex attributes: C.q (eq. 9), C.pos (eq. 8), the mean critical points (elbow, 
 from __future__ import annotations
 
 import itertools
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -110,9 +111,6 @@ class KinematicGraph:
     def manipulability(self) -> np.ndarray:
         return self.arm.manipulability(self.q)
 
-    def centroids(self) -> np.ndarray:
-        return self.voxel * self.t_res
-
     def clusters_per_voxel(self) -> np.ndarray:
         """(occupied voxels,) the number of clusters (KG vertices) in each occupied voxel."""
         _, counts = np.unique(voxel_keys(self.voxel), return_counts=True)
@@ -134,7 +132,23 @@ class CGrid:
         return tuple(len(a) for a in self.axes)
 
 
+MAX_NODES = 4_000_000   # C-grid nodes one graph may have (memory: ~0.3 kB per node with its edges and FK)
+
+
+def grid_nodes(arm: RegionalArm, c_res: float) -> int:
+    """|𝔙_C| = Π |jv| of the joint grid at C_res, before building it."""
+    return math.prod(len(joint_values(lo, hi, c_res)) for lo, hi in zip(arm.lower, arm.upper, strict=True))
+
+
+def check_size(arm: RegionalArm, c_res: float) -> None:
+    """Refuse a C_res whose grid would not fit in memory (ValueError), before anything is built."""
+    if grid_nodes(arm, c_res) > MAX_NODES:
+        raise ValueError(f"C_res = {math.degrees(c_res):g}° gives {grid_nodes(arm, c_res):,} C-grid nodes for "
+                         f"{arm.name}, more than {MAX_NODES:,}: choose a coarser C_res")
+
+
 def sample(arm: RegionalArm, c_res: float) -> CGrid:
+    check_size(arm, c_res)
     start = time.perf_counter()
     axes = [joint_values(lo, hi, c_res) for lo, hi in zip(arm.lower, arm.upper, strict=True)]
     mesh = np.meshgrid(*axes, indexing="ij")

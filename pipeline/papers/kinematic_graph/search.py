@@ -25,7 +25,6 @@ from scipy.spatial import cKDTree
 from pipeline.papers.kinematic_graph.graph import voxel_box, voxel_index, voxel_keys
 
 METRICS = ("cspace", "tspace", "manipulability", "manipulability-admissible")
-PAPER_METRICS = ("cspace", "tspace", "manipulability")
 
 
 # metric codes of the compiled heuristic
