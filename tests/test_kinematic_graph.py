@@ -339,11 +339,16 @@ def test_bad_search_input_is_refused(override):
     assert len(str(err.value)) < 300 and "\n" not in str(err.value)
 
 
-def test_a_grid_too_large_is_a_failed_run_before_anything_is_built():
-    from pipeline.core.checks import compose_config
-    from pipeline.core.runlog import SimulationFailed
-    from pipeline.papers.kinematic_graph import experiments as kx
-
-    cfg = compose_config(["experiment=kinematic-graph/spatial", "graph.c_res_deg=0.5"])
-    with pytest.raises(SimulationFailed, match="coarser C_res"):
-        kx.world_of(cfg, "puma")
+@pytest.mark.parametrize(("args", "says"), [
+    (["experiment=kinematic-graph/spatial", "graph.c_res_deg=1.5", "search.pairs=1", "search.baseline=[]"],
+     "choose a coarser C_res"),
+    (["experiment=kinematic-graph/table1", "scenario.c_res_deg=[0.25]", "system.planar.lower=[-6.28,-6.28]",
+      "system.planar.upper=[6.28,6.28]"], "choose a coarser C_res"),
+    (["experiment=kinematic-graph/search", "search.pairs=1000", "graph.c_res_deg=0.5"], "more than the budget"),
+    (["experiment=kinematic-graph/search", "scenario.obstacles.names=[a,b]"], "2 names, 1 centres"),
+    (["experiment=kinematic-graph/search", "execute.log_dt=0.0001"], "shorter than the physics step"),
+])
+def test_too_large_or_inconsistent_input_is_refused_in_one_line(args, says):
+    with pytest.raises(BadInput) as err:
+        preflight(args)
+    assert says in str(err.value) and len(str(err.value)) < 300 and "\n" not in str(err.value)

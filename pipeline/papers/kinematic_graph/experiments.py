@@ -93,18 +93,9 @@ def _world(arm_name: str, node_yaml: str, c_res: float, t_res: float, limit_fact
                  limit_factor), TaskSpacePlanner(kg, limit_factor), mu_max, build_seconds)
 
 
-def _size_check(arm: RegionalArm, c_res: float) -> None:
-    """A grid too large for memory is a failed run with its reason, before anything is built."""
-    try:
-        kgraph.check_size(arm, c_res)
-    except ValueError as err:
-        raise SimulationFailed(str(err)) from None
-
-
 def world_of(cfg: DictConfig, arm_name: str) -> World:
     import yaml
 
-    _size_check(arm_of(cfg, arm_name), math.radians(cfg.graph.c_res_deg))
     return _world(arm_name, yaml.safe_dump(arm_node(cfg, arm_name)), math.radians(cfg.graph.c_res_deg),
                   float(cfg.graph.t_res), float(cfg.search.limit_factor))
 
@@ -232,12 +223,13 @@ def obstacle_markers(boxes: Boxes) -> list:
 def table1(cfg: DictConfig) -> list[Case]:
     sc = cfg.scenario
     arm = arm_of(cfg, "planar")
+    for c_deg in sc.c_res_deg:   # a grid too large for memory is refused before anything runs
+        kgraph.check_size(arm, math.radians(c_deg))
 
     def simulate(log: RunWriter) -> None:
         records, stages = [], []
         for c_deg in sc.c_res_deg:
             c_res = math.radians(c_deg)
-            _size_check(arm, c_res)
             sampled = kgraph.sample(arm, c_res)
             for t_res in sc.t_res:
                 graph = kgraph.build(arm, c_res, t_res, sampled)
@@ -468,6 +460,7 @@ def showcase_query(node) -> Query:
 def search(cfg: DictConfig) -> list[Case]:
     """Secs. 3.3-3.4, Figs. 2-5, on the planar 2R."""
     sc = cfg.scenario
+    kgraph.check_size(arm_of(cfg, "planar"), math.radians(cfg.graph.c_res_deg))
     cases = []
     for k, scene_name in enumerate(sc.scenes):
         boxes = boxes_of(sc.obstacles) if scene_name == "obstacle" else Boxes.none()
@@ -482,6 +475,7 @@ def search(cfg: DictConfig) -> list[Case]:
 def spatial(cfg: DictConfig) -> list[Case]:
     """Sec. 4.1, Fig. 6: the regional structure of a PUMA 560 in a cluttered cell, collisions by MuJoCo."""
     sc = cfg.scenario
+    kgraph.check_size(arm_of(cfg, "puma"), math.radians(cfg.graph.c_res_deg))
     boxes = boxes_of(sc.obstacles)
     cases = [Case("benchmark", benchmark_case(cfg, "puma", boxes, cfg.seed))]
     query = showcase_query(sc.showcase)
