@@ -62,6 +62,12 @@ def test_runs_carry_the_replay(data, tmp_path):
     assert {"/joint_state", "/reference", "/command", "/tracking_error", "/tf", "/markers", "/clearance",
             "/kg/path", "/kg/vertices"} <= set(run.topic_names)
     assert "model.xml" in run.attachments and run.status == "ok"
+    # the arm and the obstacle are drawn from the attached model: its URDF, moved by the logged joints
+    assert {"/robot_description", "/joint_states", "/tf/robot"} <= set(run.topic_names)
+    urdf = run.attachments["robot.urdf"].decode()
+    assert urdf.count("<box ") == 1 and 'name="joint1"' in urdf and 'name="joint2"' in urdf
+    bench = read_run(data / "runs" / "kinematic-graph" / "search" / "benchmark-obstacle.mcap")
+    assert bench["/markers"].filter(like="cubes.0.size.x").iloc[0].tolist() == pytest.approx([0.1])
     assert list(run["/joint_state"].filter(like="position.").columns) == ["position.joint1", "position.joint2"]
     assert run["/clearance"]["value.executed.min"].min() > -0.01   # the KG plan passes the obstacle
     tonly = read_run(data / "runs" / "kinematic-graph" / "search" / "obstacle-tspace-only.mcap")

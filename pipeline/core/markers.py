@@ -25,14 +25,6 @@ def spheres(frames: Sequence[str], radii: Sequence[float], colors: Sequence[Sequ
         for frame, r, c in zip(frames, radii, colors, strict=True)]
 
 
-def box(name: str, centre: Sequence[float], size: Sequence[float], color: Sequence[float], frame: str = "world"):
-    """An axis-aligned box of edge lengths `size` centred at `centre` in `frame`."""
-    pose = schemas.Pose(position=schemas.Vector3(x=centre[0], y=centre[1], z=centre[2]),
-                        orientation=schemas.Quaternion(w=1.0))
-    cube = schemas.CubePrimitive(pose=pose, size=schemas.Vector3(x=size[0], y=size[1], z=size[2]), color=_color(color))
-    return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True, cubes=[cube])
-
-
 def height_field(name: str, x: np.ndarray, y: np.ndarray, z: np.ndarray, frame: str = "world",
                  color: Sequence[float] = (0.63, 0.63, 0.59, 1.0)):
     """A surface z[i, j] over the grid (x[j], y[i]) as a triangle mesh in `frame`."""

@@ -4,7 +4,7 @@ Post-processing (Secs. 3.5.2, 4.2.5): the joint path is q_i, the C.q of the path
 configuration found by a numerical IK started at the last vertex (the plan is its "perfect initial guess"). It is
 interpolated linearly in joint space (large C-space steps occur near singularities) and timed by one trapezoidal
 velocity profile over its joint-space arc length. The MuJoCo arm (generated from the DH table) follows it under
-the joint PD servo of `pipeline.robotics.mjcf` at every physics step.
+the joint PD servo of `pipeline.robotics.mjcf` at every physics step (`mjcf.servo_rollout`).
 """
 
 from __future__ import annotations
@@ -104,25 +104,19 @@ def timed_reference(waypoints: np.ndarray, dt: float, speed: float, accel_fracti
     return Reference(waypoints, arrival, times, q, qd)
 
 
-def run_servo(xml: str, ref: Reference) -> tuple[np.ndarray, np.ndarray]:
-    """The servoed run in one C call (`mujoco.rollout`): (states, sensors) after every step. The wrist joints
-    (if any) are held at 0."""
+def padded(ref: Reference, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(q, q̇) of the reference for all `n` joints of the arm: the wrist joints (if any) held at 0."""
+    q, qd = np.zeros((len(ref.times), n)), np.zeros((len(ref.times), n))
+    q[:, : ref.q.shape[1]], qd[:, : ref.qd.shape[1]] = ref.q, ref.qd
+    return q, qd
+
+
+def obstacle_geoms(boxes: Boxes) -> list:
+    """/markers entities of the obstacles, drawn from the same MuJoCo geoms the checkers and the arm's model use."""
     import mujoco
-    from mujoco import rollout
 
-    from pipeline.robotics.mjcf import check_mujoco
+    from pipeline.core import markers
 
-    model = mujoco.MjModel.from_xml_string(xml)
-    data = mujoco.MjData(model)
-    nu = model.nu // 2
-    q_ref = np.zeros((len(ref.times), nu))
-    qd_ref = np.zeros((len(ref.times), nu))
-    q_ref[:, : ref.q.shape[1]], qd_ref[:, : ref.q.shape[1]] = ref.q, ref.qd
-    data.qpos[:] = q_ref[0]
-    mujoco.mj_forward(model, data)
-    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    state0 = np.empty(mujoco.mj_stateSize(model, spec))
-    mujoco.mj_getState(model, data, state0, spec)
-    states, sensors = rollout.rollout(model, data, state0, np.concatenate([q_ref, qd_ref], axis=1)[None])
-    check_mujoco(data, states[0], ref.times)
-    return states[0], sensors[0]
+    model = mujoco.MjModel.from_xml_string(f'<mujoco model="obstacles"><worldbody>{obstacles_xml(boxes)}'
+                                           "\n  </worldbody></mujoco>")
+    return markers.mujoco_geoms(model)

@@ -24,6 +24,7 @@ from pipeline.papers.kinematic_graph import graph as kgraph
 from pipeline.papers.kinematic_graph.arms import RegionalArm
 from pipeline.papers.kinematic_graph.collision import Boxes, MujocoChecker, PlanarChecker
 from pipeline.papers.kinematic_graph.search import Plan, Planner, Query, Space, TaskSpacePlanner
+from pipeline.robotics.mjcf import servo_rollout
 
 KgSize = schemas.define(
     "KgSize", "One kinematic graph (Table 1): resolutions, C-grid and KG sizes, occupied voxels holding k clusters "
@@ -209,14 +210,6 @@ def log_records(log: RunWriter, topic: str, records: list[dict], spacing: float 
     log.log_series(topic, np.arange(len(records)) * spacing, KgSearch, **columns)
 
 
-# -- scene drawing ---------------------------------------------------------------------------------------------
-
-
-def obstacle_markers(boxes: Boxes) -> list:
-    return [markers.box(f"obstacle/{n}", c, 2 * h, (0.85, 0.45, 0.2, 0.6))
-            for n, c, h in zip(boxes.names, boxes.centre, boxes.half, strict=True)]
-
-
 # -- E1: Table 1 and Sec. 3.2 ------------------------------------------------------------------------------------
 
 
@@ -306,7 +299,7 @@ def benchmark_case(cfg: DictConfig, arm_name: str, boxes: Boxes, seed: int):
             seconds.setdefault(f"{r['graph']}.{r['metric']}", []).append(r["seconds"])
         log_timings(log, [Timing(name, np.array(s)) for name, s in seconds.items()])
         if len(boxes):
-            log.write("/markers", 0, schemas.SceneUpdate(entities=obstacle_markers(boxes)))
+            log.write("/markers", 0, schemas.SceneUpdate(entities=ex.obstacle_geoms(boxes)))
 
     return simulate
 
@@ -314,33 +307,6 @@ def benchmark_case(cfg: DictConfig, arm_name: str, boxes: Boxes, seed: int):
 # -- showcase plans, executed in MuJoCo ---------------------------------------------------------------------------
 
 VERTEX_STATES = {"unvisited": 0, "queued": 1, "expanded": 2, "path": 3, "colliding": 4}   # the colours of Fig. 5
-
-
-def link_markers(node: dict, n_links: int) -> list:
-    """A cylinder per link in its DH frame i, from the origin back to frame i−1's origin (constant there:
-    Rx(−α_i)·(−a_i, 0, −d_i)), so that Foxglove draws the arm from /tf alone."""
-    entities = []
-    for i in range(n_links):
-        a, d, alpha = (float(node["dh"][k][i]) for k in ("a", "d", "alpha"))
-        back = np.array([-a, -d * math.sin(alpha), -d * math.cos(alpha)])
-        length = float(np.linalg.norm(back))
-        r = float(node["link_radius"])
-        if length < 1e-9:
-            entities += markers.spheres([f"link{i + 1}"], [r], [(0.55, 0.6, 0.68, 1.0)])
-            continue
-        z = back / length
-        axis = np.cross([0.0, 0.0, 1.0], z)
-        angle = math.atan2(np.linalg.norm(axis), z[2])
-        axis = axis / np.linalg.norm(axis) if np.linalg.norm(axis) > 1e-12 else np.array([1.0, 0.0, 0.0])
-        qw, qv = math.cos(angle / 2), axis * math.sin(angle / 2)
-        centre = back / 2
-        entities.append(schemas.SceneEntity(frame_id=f"link{i + 1}", id=f"link{i + 1}/capsule", frame_locked=True,
-                                            cylinders=[schemas.CylinderPrimitive(
-            pose=schemas.Pose(position=schemas.Vector3(x=centre[0], y=centre[1], z=centre[2]),
-                              orientation=schemas.Quaternion(w=qw, x=qv[0], y=qv[1], z=qv[2])),
-            size=schemas.Vector3(x=2 * r, y=2 * r, z=length), bottom_scale=1.0, top_scale=1.0,
-            color=schemas.Color(r=0.55, g=0.6, b=0.68, a=1.0))]))
-    return entities
 
 
 def showcase_plan(world: World, scene: Scene, metric: str, query: Query) -> tuple[Plan, np.ndarray, str, int]:
@@ -377,7 +343,7 @@ def showcase_case(cfg: DictConfig, arm_name: str, boxes: Boxes, query: Query, me
         ref = ex.timed_reference(waypoints, e.dt, e.speed, e.accel_fraction, e.settle)
         xml = ex.arm_xml(arm_name, node, boxes, waypoints[0], e.dt, e.bandwidth_hz, e.damping_ratio)
         log.attach("model.xml", xml, "application/xml")
-        states, sensors = ex.run_servo(xml, ref)
+        states, sensors = servo_rollout(xml, *ex.padded(ref, len(node["dh"]["a"])), ref.times)
         log_execution(log, cfg, world, MujocoChecker(xml, ex.checked_links(node)) if len(boxes) else None, node, ref,
                       states, sensors, query)
 
@@ -401,8 +367,8 @@ def showcase_case(cfg: DictConfig, arm_name: str, boxes: Boxes, query: Query, me
                                  "mu", "members", "state"],
                            value=np.column_stack([kg.pos, kg.q, world.kg_planner.space.mu, kg.members, state]))
         planned = arm.points(waypoints)[:, -1]
+        # the arm and the obstacles are the attached model's (robot.urdf, drawn from /joint_state)
         log.write("/markers", 0, schemas.SceneUpdate(entities=[
-            *obstacle_markers(boxes), *link_markers(node, len(node["dh"]["a"])),
             markers.line_strip("plan", planned, thickness=0.006, color=(0.85, 0.1, 0.1, 1.0)),
             *markers.spheres(["goal"], [0.02], [(0.1, 0.7, 0.2, 1.0)])]))
 
@@ -423,9 +389,7 @@ def log_execution(log: RunWriter, cfg: DictConfig, world: World, checker: Mujoco
     q = states[every, 1: 1 + n_all]
     qd = states[every, 1 + n_all: 1 + 2 * n_all]
     tau = sensors[every, :n_all]
-    q_ref = np.zeros((len(times), n_all))
-    qd_ref = np.zeros((len(times), n_all))
-    q_ref[:, : arm.n], qd_ref[:, : arm.n] = ref.q[every], ref.qd[every]
+    q_ref, qd_ref = (x[every] for x in ex.padded(ref, n_all))
     if not np.isfinite(q).all():
         raise SimulationFailed("the servoed arm's state is not finite")
     log.log_series("/joint_state", times, name=names, position=q, velocity=qd, effort=tau)
