@@ -2,7 +2,7 @@
 spatial graph of Fig. 6 (`spatial`)."""
 
 from analysis.papers.kinematic_graph.analyses import analyze_search, analyze_spatial, analyze_table1
-from analysis.papers.kinematic_graph.tables import report_sections
+from analysis.papers.kinematic_graph.sections import report_sections
 
 ANALYSES = {"table1": analyze_table1, "search": analyze_search, "spatial": analyze_spatial}
 

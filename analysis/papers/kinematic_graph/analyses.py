@@ -32,7 +32,7 @@ def analyze_search(runs: list[Run], figures: Figures) -> pd.DataFrame:
         fig.searched_kg_figure(by_id["obstacle-manipulability"], figures, "fig5-searched-kg")
     for run in runs:
         if run.metadata["case"].startswith("benchmark"):
-            fig.benchmark_figure(run, figures, run.run_id)
+            fig.benchmark_figure(run, figures, run.run_id, "Fig2" if run.run_id == "benchmark-free" else None)
     for scene in ("free", "obstacle"):
         fig.execution_figure([r for r in runs if r.metadata["case"].startswith(f"{scene}-")], figures,
                              f"execution-{scene}")
@@ -44,6 +44,6 @@ def analyze_spatial(runs: list[Run], figures: Figures) -> pd.DataFrame:
     by_id = {r.run_id: r for r in runs}
     fig.spatial_figure(by_id, figures)
     if "benchmark" in by_id:
-        fig.benchmark_figure(by_id["benchmark"], figures, "benchmark")
+        fig.benchmark_figure(by_id["benchmark"], figures, "benchmark", "Fig6")
     fig.execution_figure([r for r in runs if not r.metadata["case"].startswith("benchmark")], figures, "execution")
     return frame

@@ -6,8 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from analysis.core.figures import Figures, plt
-from analysis.papers.kinematic_graph.metrics import PAPER_METRICS, printed
+from analysis.core.figures import Figures, paper_point, plt
+from analysis.core.targets import paper_value
+from analysis.papers.kinematic_graph.metrics import PAPER_METRICS, SLUG
 from pipeline.core.runlog import Run
 from pipeline.papers.kinematic_graph.arms import RegionalArm
 
@@ -40,10 +41,10 @@ def table1_figure(metrics: pd.DataFrame, figures: Figures) -> None:
         for ax, what in zip(axes[:2], ("vertices", "edges"), strict=True):
             ax.plot(t_res, [ours[f"{c}_T{t:g}.{what}"] for t in t_res], "o-", color=f"C{k}",
                     label=f"pipeline, {c[1:]}°")
-            ax.plot(t_res, [printed(f"T1.{c}_T{t:g}.{what}") for t in t_res], "kx", ms=7,
+            ax.plot(t_res, [paper_value(SLUG, f"T1.{c}_T{t:g}.{what}") for t in t_res], "kx", ms=7,
                     label="paper, Table 1" if k == 0 else None)
         for what, marker in (("vertices", "o"), ("edges", "s")):
-            dev = [100 * (ours[f"{c}_T{t:g}.{what}"] / printed(f"T1.{c}_T{t:g}.{what}") - 1) for t in t_res]
+            dev = [100 * (ours[f"{c}_T{t:g}.{what}"] / paper_value(SLUG, f"T1.{c}_T{t:g}.{what}") - 1) for t in t_res]
             axes[2].plot(t_res, dev, marker + "-", color=f"C{k}", label=f"|V_k|, {c[1:]}°" if what == "vertices"
                          else f"|E_k|, {c[1:]}°")
     for ax, title in zip(axes[:2], ("|V_k| (KG vertices)", "|E_k| (KG edges)"), strict=True):
@@ -176,28 +177,41 @@ def searched_kg_figure(run: Run, figures: Figures, name: str) -> None:
 # -- benchmarks -------------------------------------------------------------------------------------------------
 
 
-def benchmark_figure(run: Run, figures: Figures, name: str) -> None:
+def benchmark_figure(run: Run, figures: Figures, name: str, paper_figure: str | None = None) -> None:
+    """Per query: vertices expanded, planning time, the share of the KG explored (beside the share the paper
+    prints for its one query of `paper_figure`, Fig2 or Fig6), and how many plans are found and collision-free."""
     df = run["/kg/search"]
     groups = [(g, m) for g in ("kg", "grid", "tonly") for m in (*PAPER_METRICS, "manipulability-admissible")
               if ((df["graph"] == g) & (df["metric"] == m)).any()]
     labels = [f"{g}\n{m.replace('manipulability', 'manip.')}" for g, m in groups]
     pick = {gm: df[(df["graph"] == gm[0]) & (df["metric"] == gm[1])] for gm in groups}
-    fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
+    fig, axes = plt.subplots(1, 4, figsize=(16, 3.8))
     axes[0].boxplot([pick[gm]["expanded"].to_numpy() for gm in groups], showfliers=False)
     axes[0].set_yscale("log")
     axes[0].set_ylabel("vertices expanded per query")
     axes[1].boxplot([pick[gm]["seconds"].to_numpy() * 1e3 for gm in groups], showfliers=False)
     axes[1].set_yscale("log")
     axes[1].set_ylabel("planning time per query [ms]")
+    kg = [m for m in PAPER_METRICS if ("kg", m) in pick]
+    axes[2].boxplot([pick[("kg", m)]["explored_pct"].to_numpy() for m in kg], whis=(5, 95), showfliers=True)
+    if paper_figure:
+        for k, m in enumerate(kg):
+            paper_point(axes[2], k + 1, paper_value(SLUG, f"{paper_figure}.explored.{m}"),
+                        label=f"paper ({paper_figure.replace('Fig', 'Fig. ')}, one query)" if k == 0 else None)
+        axes[2].legend(fontsize=7, loc="upper left")
+    axes[2].set_yscale("log")
+    axes[2].set_ylabel("share of the KG explored per query [%]\n(whiskers: 5th-95th percentile)")
+    axes[2].set_xticks(np.arange(1, len(kg) + 1), [m.replace("manipulability", "manip.") for m in kg], fontsize=7)
     width = 0.4
     x = np.arange(len(groups))
-    axes[2].bar(x - width / 2, [pick[gm]["found"].mean() for gm in groups], width, label="found")
-    axes[2].bar(x + width / 2, [(pick[gm]["found"] & pick[gm]["collision_free"]).mean() for gm in groups], width,
+    axes[3].bar(x - width / 2, [pick[gm]["found"].mean() for gm in groups], width, label="found")
+    axes[3].bar(x + width / 2, [(pick[gm]["found"] & pick[gm]["collision_free"]).mean() for gm in groups], width,
                 label="found and collision-free (dense check)")
-    axes[2].set_ylim(0, 1.05)
-    axes[2].legend(fontsize=7, loc="lower left")
-    for ax in axes:
-        ax.set_xticks(np.arange(1, len(groups) + 1) if ax is not axes[2] else x, labels, fontsize=6, rotation=60)
+    axes[3].set_ylim(0, 1.05)
+    axes[3].legend(fontsize=7, loc="lower left")
+    for ax in (axes[0], axes[1]):
+        ax.set_xticks(np.arange(1, len(groups) + 1), labels, fontsize=6, rotation=60)
+    axes[3].set_xticks(x, labels, fontsize=6, rotation=60)
     fig.suptitle(f"{run.run_id}: {df['query'].nunique()} seeded queries (kg: kinematic graph, grid: plain C-grid, "
                  "tonly: T-space voxels + IK)", fontsize=9)
     figures.save(fig, name)

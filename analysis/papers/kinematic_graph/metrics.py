@@ -7,7 +7,6 @@ tonly.tspace). Explored shares are fractions (the targets show %).
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -15,21 +14,15 @@ import pandas as pd
 from analysis.core.compute_time import timing_metrics
 from analysis.core.errors import error_stats
 from analysis.core.metrics import MetricTable
-from analysis.core.targets import load_targets
+from analysis.core.targets import paper_value
 from pipeline.core.runlog import Run
 
-TARGETS = Path(__file__).with_name("targets.csv")
+SLUG = "kinematic-graph"
 PAPER_METRICS = ("cspace", "tspace", "manipulability")
 
 
 def cell(c_res_rad: float, t_res: float) -> str:
     return f"C{round(math.degrees(c_res_rad), 6):g}_T{t_res:g}"
-
-
-def printed(target_id: str) -> float:
-    """A number the paper prints (targets.csv), for the paper-consistency checks."""
-    targets = load_targets(TARGETS).set_index("target_id")
-    return float(targets.loc[target_id, "value"])
 
 
 # -- Table 1 -------------------------------------------------------------------------------------------------------
@@ -67,13 +60,13 @@ def paper_consistency() -> dict[str, tuple[float, str]]:
     0.5° edge ratios of Table 1 recomputed from its printed counts."""
     values = {}
     for c in ("C2", "C1", "C0.5"):
-        jv = printed(f"jv.{c}")
+        jv = paper_value(SLUG, f"jv.{c}")
         values[f"paper.eq6.{c}"] = (jv ** 2, "count")                       # eq. (6)
         values[f"paper.eq7.{c}"] = (4 * jv ** 2 - 6 * jv + 2, "count")      # eq. (7)
     values["paper.eq5.dim6"] = (3.0 ** 6 - 1, "count")                      # eq. (5)
     for t in ("0.1", "0.05", "0.03", "0.01"):
-        edges = printed(f"T1.C0.5_T{t}.edges")
-        values[f"paper.C0.5_T{t}.edge_ratio.printed_denominator"] = (edges / printed("EC.C0.5"), "ratio")
+        edges = paper_value(SLUG, f"T1.C0.5_T{t}.edges")
+        values[f"paper.C0.5_T{t}.edge_ratio.printed_denominator"] = (edges / paper_value(SLUG, "EC.C0.5"), "ratio")
         values[f"paper.C0.5_T{t}.edge_ratio.eq7_denominator"] = (edges / values["paper.eq7.C0.5"][0], "ratio")
     return values
 
