@@ -6,7 +6,7 @@
 Rerun also opens the .mcap directly (`rerun <run>.mcap`): it draws /tf and decodes every other channel as
 queryable fields. This converter adds what reflection cannot: every numeric column as a time series on a
 `sim_time` timeline, the /tf frames as a 3-D skeleton (frames joined in the order they are logged), and the
-spheres and cylinders of `/markers` (Foxglove SceneUpdate) drawn in the /tf frame each entity names.
+spheres, cylinders and cubes of `/markers` (Foxglove SceneUpdate) drawn in the /tf frame each entity names.
 """
 
 from __future__ import annotations
@@ -44,7 +44,7 @@ def _rgba(color) -> list[float]:
 
 
 def _log_markers(rec: rr.RecordingStream, run_path: Path) -> None:
-    """SceneUpdate spheres, cylinders and triangle meshes under world/<frame_id>/<entity id>: they move with
+    """SceneUpdate spheres, cylinders, cubes and triangle meshes under world/<frame_id>/<entity id>: they move with
     that /tf frame."""
     with open(run_path, "rb") as f:
         reader = make_reader(f, decoder_factories=[DecoderFactory()])
@@ -65,6 +65,14 @@ def _log_markers(rec: rr.RecordingStream, run_path: Path) -> None:
                         quaternions=[[x.pose.orientation.x, x.pose.orientation.y, x.pose.orientation.z,
                                       x.pose.orientation.w] for x in c],
                         colors=[_rgba(x.color) for x in c]))
+                if entity.cubes:
+                    c = entity.cubes
+                    rec.log(f"{path}/cubes", rr.Boxes3D(
+                        half_sizes=[[x.size.x / 2, x.size.y / 2, x.size.z / 2] for x in c],
+                        centers=[[x.pose.position.x, x.pose.position.y, x.pose.position.z] for x in c],
+                        quaternions=[[x.pose.orientation.x, x.pose.orientation.y, x.pose.orientation.z,
+                                      x.pose.orientation.w] for x in c],
+                        colors=[_rgba(x.color) for x in c], fill_mode="solid"))
                 for k, mesh in enumerate(entity.triangles):
                     rec.log(f"{path}/triangles{k}", rr.Mesh3D(
                         vertex_positions=[[p.x, p.y, p.z] for p in mesh.points],

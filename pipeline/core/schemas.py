@@ -11,6 +11,7 @@ A paper that needs a record the common schemas cannot hold declares it with `def
 from __future__ import annotations
 
 from foxglove_schemas_protobuf.Color_pb2 import Color
+from foxglove_schemas_protobuf.CubePrimitive_pb2 import CubePrimitive
 from foxglove_schemas_protobuf.CylinderPrimitive_pb2 import CylinderPrimitive
 from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
 from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
@@ -117,9 +118,9 @@ def for_topic(topic: str) -> type[Message] | None:
     return None
 
 
-__all__ = ["TOPICS", "Color", "CylinderPrimitive", "FrameTransform", "FrameTransforms", "Point3", "Pose",
-           "PosesInFrame", "Quaternion", "SceneEntity", "SceneUpdate", "SpherePrimitive", "TriangleListPrimitive",
-           "Vector3", "define", "for_topic", "stamp"]
+__all__ = ["TOPICS", "Color", "CubePrimitive", "CylinderPrimitive", "FrameTransform", "FrameTransforms", "Point3",
+           "Pose", "PosesInFrame", "Quaternion", "SceneEntity", "SceneUpdate", "SpherePrimitive",
+           "TriangleListPrimitive", "Vector3", "define", "for_topic", "stamp"]
 
 
 def stamp(t_ns: int) -> timestamp_pb2.Timestamp:
