@@ -15,6 +15,7 @@ from analysis.papers.itbot_smc.metrics import (
     law_of,
     plant_agreement,
     reaching_metrics,
+    system_of,
 )
 from pipeline.core.runlog import Run
 
@@ -25,15 +26,20 @@ WHERE = {"analytic": "analytic plant, exact joint states", "mujoco": "MuJoCo pla
 
 def analyze_tracking(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
-    groups: dict[str, dict[str, Run]] = {}
+    groups: dict[tuple[str, str], dict[str, Run]] = {}   # (group, overrides suffix) -> law -> run
     for run in runs:
-        m.add_run(run, closed_loop_metrics(run))
-        groups.setdefault(group_of(run.metadata["case"]), {})[law_of(run)] = run
+        group, _ = group_of(run)
+        m.add_run(run, closed_loop_metrics(run, detail=group == FIGURE_GROUP))   # timing: the analytic runs
+        groups.setdefault(group_of(run), {})[law_of(run)] = run
     frame = m.frame()
-    for group, laws in groups.items():
-        claims(m, frame, group, None if set(laws) >= set(LAWS) else FIGURE_GROUP)
-    plant_agreement(m, frame)
-    ordered = {group: {law: laws[law] for law in LAWS if law in laws} for group, laws in groups.items()}
+    for (group, suffix), laws in groups.items():
+        claims(m, frame, group, None if set(laws) >= set(LAWS) else FIGURE_GROUP, suffix)
+    for suffix in {suffix for _, suffix in groups}:
+        plant_agreement(m, frame, suffix)
+    # the figures: the runs without overrides if there are any, else the first set of overrides
+    suffix = "" if any(s == "" for _, s in groups) else min(s for _, s in groups) if groups else ""
+    ordered = {group: {law: laws[law] for law in LAWS if law in laws}
+               for (group, s), laws in groups.items() if s == suffix}
     if FIGURE_GROUP in ordered:
         runs_ = ordered[FIGURE_GROUP]
         fig.hand_figures(runs_, figures, WHERE[FIGURE_GROUP])
@@ -55,12 +61,13 @@ def analyze_smc_sweep(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     rows = []
     for run in runs:
-        smc = run.config["system"]["control"]["smc"]
+        control = system_of(run)["control"]
+        smc = control["smc"]
         params = {"gain_scale": float(smc["gain_scale"]), "boundary_layer": float(smc["boundary_layer"])}
-        values = closed_loop_metrics(run, detail=False)
+        values = closed_loop_metrics(run, detail=False, forces=False)
         for metric, (value, unit) in values.items():
             m.add(run.run_id, metric, value, unit, params)
-        K = run.config["system"]["control"]["K"] if smc["K"] is None else smc["K"]
+        K = control["K"] if smc["K"] is None else smc["K"]
         rows.append({**params, "K1": float(K[0]) * params["gain_scale"],
                      **{k: v for k, (v, _) in values.items()}})
     if rows:
@@ -75,7 +82,7 @@ def analyze_load_support(runs: list[Run], figures: Figures) -> pd.DataFrame:
         values = closed_loop_metrics(run, detail=False)
         m.add_run(run, values)
         if run.metadata["case"].startswith("support-"):
-            rows.append({"support": float(run.config["system"]["hand"]["support"]),
+            rows.append({"support": float(system_of(run)["hand"]["support"]),
                          **{k: v for k, (v, _) in values.items()}})
     if rows:
         band = pd.DataFrame(rows).sort_values("support")

@@ -83,6 +83,15 @@ def joint_figures(runs: dict[str, Run], figures: Figures, where: str) -> None:
     figures.save(fig9, "fig9-joint-errors")
 
 
+def _torque_band(ax, t: np.ndarray, tau: np.ndarray, color: str, style: str, label: str) -> None:
+    """A chattering torque: the band it switches in (min-max per ENVELOPE ticks) and its part below 10 Hz."""
+    blocks = len(t) // ENVELOPE
+    chunks = tau[:blocks * ENVELOPE].reshape(blocks, ENVELOPE)
+    ax.fill_between(t[:blocks * ENVELOPE:ENVELOPE], chunks.min(axis=1), chunks.max(axis=1), color=color, alpha=0.2,
+                    lw=0)
+    ax.plot(t, low_pass(t, tau), style, color=color, lw=1.1, label=label)
+
+
 def torque_figure(runs: dict[str, Run], figures: Figures, where: str, name: str, number: str = "10") -> None:
     """Fig. 10: joint torques over the run (the band each law's torque chatters in, min/max per 10 ticks, and its
     part below 10 Hz) and the first 50 ticks, where every switch shows."""
@@ -91,13 +100,9 @@ def torque_figure(runs: dict[str, Run], figures: Figures, where: str, name: str,
         command = run["/command"]
         t = command.index.to_numpy()
         zoom = (t >= ZOOM[0]) & (t <= ZOOM[1])
-        blocks = len(t) // ENVELOPE
         for i, j in enumerate(JOINTS):
             tau = command[f"value.{j}"].to_numpy()
-            chunks = tau[:blocks * ENVELOPE].reshape(blocks, ENVELOPE)
-            axes[i, 0].fill_between(t[:blocks * ENVELOPE:ENVELOPE], chunks.min(axis=1), chunks.max(axis=1),
-                                    color=COLORS[law], alpha=0.2, lw=0)
-            axes[i, 0].plot(t, low_pass(t, tau), STYLES[law], color=COLORS[law], lw=1.1, label=LABELS[law])
+            _torque_band(axes[i, 0], t, tau, COLORS[law], STYLES[law], LABELS[law])
             axes[i, 1].plot(t[zoom], tau[zoom], STYLES[law], color=COLORS[law], lw=0.9, drawstyle="steps-post")
             axes[i, 0].set_ylabel(f"τ{i + 1} [N m]")
     axes[1, 0].set_xlabel("time [s] (line: below 10 Hz; band: min-max per 10 ms)")
@@ -132,13 +137,14 @@ def force_figure(runs: dict[str, Run], figures: Figures, where: str) -> None:
 def plant_figure(analytic: Run, mujoco: Run, figures: Figures, law: str) -> None:
     """The same run on both plants: joint errors and torques over each other."""
     fig, axes = plt.subplots(2, 2, figsize=(11, 5))
-    for run, label, style in ((analytic, "analytic (eqs. A7-A12)", "-"), (mujoco, "MuJoCo", "--")):
+    for run, label, style, color in ((analytic, "analytic (eqs. A7-A12)", "-", "C0"), (mujoco, "MuJoCo", "--", "C1")):
         e, command = run["/tracking_error"], run["/command"]
+        t = command.index.to_numpy()
         for i, j in enumerate(JOINTS):
-            axes[0, i].plot(e.index, _deg(e[f"error.{j}"]), style, lw=0.8, label=label)
-            axes[1, i].plot(command.index, command[f"value.{j}"], style, lw=0.3, label=label)
+            axes[0, i].plot(e.index, _deg(e[f"error.{j}"]), style, color=color, lw=0.8, label=label)
+            _torque_band(axes[1, i], t, command[f"value.{j}"].to_numpy(), color, style, label)
             axes[0, i].set_ylabel(f"e{i + 1} [°]")
-            axes[1, i].set_ylabel(f"τ{i + 1} [N m]")
+            axes[1, i].set_ylabel(f"τ{i + 1} [N m] (line: < 10 Hz; band: min-max per 10 ms)")
             axes[1, i].set_xlabel("time [s]")
     axes[0, 0].legend(fontsize=7)
     fig.suptitle(f"{LABELS[law]} on the two plants: joint errors and torques")
@@ -154,8 +160,11 @@ def sweep_figure(frame: pd.DataFrame, figures: Figures) -> None:
         err.plot(part["K1"], _deg(part["e.max"]), "o-", label=label)
         tv.plot(part["K1"], part["tau.tv"], "o-", label=label)
     err.axhline(BOUND_DEG, color="0.5", ls="--", lw=0.8, label="paper: < 2°")
+    gains = sorted(frame["K1"].unique())
     for ax in (err, tv):
         ax.set_xscale("log")
+        ax.set_xticks(gains, [f"{k:g}" for k in gains])
+        ax.minorticks_off()
         ax.set_xlabel("K of joint 1 [rad/s²] (joint 2: × 0.4)")
         ax.legend(fontsize=7)
     err.set_ylabel("max joint error [°]")

@@ -22,12 +22,14 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+import yaml
 
 from analysis.core.compute_time import timing_metrics
 from analysis.core.errors import error_stats
 from analysis.core.metrics import MetricTable, metric_value
 from analysis.core.signals import chattering_stats, low_pass, sign_change_rate
 from pipeline.core.runlog import Run
+from pipeline.papers.itbot_smc import SYSTEM_ATTACHMENT
 from pipeline.papers.itbot_smc.model import JOINTS
 
 LAWS = ("nsmerl", "smerl", "smc")
@@ -35,14 +37,19 @@ START = 1.0          # s, the "motion start" window
 AT_LIMIT = 1e-9      # relative: a torque this close to the limit is saturated
 
 
+def system_of(run: Run) -> dict:
+    """The system config the run was simulated with (the experiment's, as its case changed it)."""
+    return yaml.safe_load(run.attachments[SYSTEM_ATTACHMENT])
+
+
 def law_of(run: Run) -> str:
     """The reaching law of a closed-loop run (its case id starts with it, or it is the sweep's SMC)."""
     return run.metadata["case"].split("-")[0] if run.metadata["case"].split("-")[0] in LAWS else "smc"
 
 
-def closed_loop_metrics(run: Run, detail: bool = True) -> dict[str, tuple[float, str]]:
-    """The metrics above; `detail` adds the sliding variable's sign changes and the controller's timing (two
-    more 1 kHz channels to read)."""
+def closed_loop_metrics(run: Run, detail: bool = True, forces: bool = True) -> dict[str, tuple[float, str]]:
+    """The metrics above; `detail` adds the sliding variable's sign changes and the controller's timing,
+    `forces` the hand force (each a 1 kHz channel to read: the analysis asks for them where it reports them)."""
     values: dict[str, tuple[float, str]] = {}
     err = run["/tracking_error"]
     t = err.index.to_numpy()
@@ -50,15 +57,17 @@ def closed_loop_metrics(run: Run, detail: bool = True) -> dict[str, tuple[float,
         values |= error_stats(t, err[f"error.{j}"].to_numpy(), f"e.{j}", "rad")
     values["e.max"] = (max(values[f"e.{j}.max"][0] for j in JOINTS), "rad")
     values["e.rms"] = (float(np.sqrt(np.mean(err["norm"].to_numpy() ** 2))), "rad")
-    settled = t >= START
-    values["e.settled.max"] = (float(err.loc[settled, [f"error.{j}" for j in JOINTS]].abs().to_numpy().max()), "rad")
+    windowed = t[-1] > 2 * START      # a run long enough for a start and an after window
+    if windowed:
+        settled = err.loc[t >= START, [f"error.{j}" for j in JOINTS]]
+        values["e.settled.max"] = (float(settled.abs().to_numpy().max()), "rad")
     hand = run["/tracking_error/hand"]["norm"].to_numpy()
     values |= {k: v for k, v in error_stats(t, hand, "hand_error", "m").items() if k.endswith((".max", ".rms"))}
 
     command = run["/command"]
     tc = command.index.to_numpy()
     tau = command[[f"value.{j}" for j in JOINTS]].to_numpy()
-    windows = {"": slice(None), "start.": tc <= START, "after.": tc >= START}
+    windows = {"": slice(None), **({"start.": tc <= START, "after.": tc >= START} if windowed else {})}
     for i, j in enumerate(JOINTS):
         for window, ticks in windows.items():
             values |= {k.replace(f"tau.{j}.", f"tau.{j}.{window}"): v
@@ -70,15 +79,16 @@ def closed_loop_metrics(run: Run, detail: bool = True) -> dict[str, tuple[float,
                                          "Nm")
     period = float(tc[1] - tc[0])
     values["effort"] = (float((tau ** 2).sum() * period), "N^2*m^2*s")
-    limit = np.asarray(run.config["system"]["drive"]["torque_limit"], dtype=float)
+    limit = np.asarray(system_of(run)["drive"]["torque_limit"], dtype=float)
     values["saturated"] = (float((np.abs(tau) >= limit * (1 - AT_LIMIT)).any(axis=1).mean()), "fraction")
 
-    wrench = run["/wrench"]
-    tw = wrench.index.to_numpy()
-    for axis in ("x", "y"):
-        force = wrench[f"force_{axis}.hand"].to_numpy()
-        values[f"force.{axis}.max"] = (float(np.abs(low_pass(tw, force)).max()), "N")
-        values[f"force.{axis}.max.raw"] = (float(np.abs(force).max()), "N")
+    if forces:
+        wrench = run["/wrench"]
+        tw = wrench.index.to_numpy()
+        for axis in ("x", "y"):
+            force = wrench[f"force_{axis}.hand"].to_numpy()
+            values[f"force.{axis}.max"] = (float(np.abs(low_pass(tw, force)).max()), "N")
+            values[f"force.{axis}.max.raw"] = (float(np.abs(force).max()), "N")
     if detail:
         v = run["/sliding_variable"]
         for j in JOINTS:
@@ -87,42 +97,47 @@ def closed_loop_metrics(run: Run, detail: bool = True) -> dict[str, tuple[float,
     return values
 
 
-def group_of(case: str) -> str:
-    """`nsmerl-analytic` -> `analytic`; `smc-hall` -> `hall`."""
-    return case.split("-", 1)[1]
+def group_of(run: Run) -> tuple[str, str]:
+    """(group, overrides suffix) of a tracking run: `nsmerl-analytic` -> (`analytic`, ``),
+    `smc-hall__system.reference.period=5` -> (`hall`, `__system.reference.period=5`)."""
+    case = run.metadata["case"]
+    return case.split("-", 1)[1], run.run_id.removeprefix(case)
 
 
-def claims(m: MetricTable, frame: pd.DataFrame, group: str, others: str | None = None) -> None:
-    """The paper's comparisons among the three laws of one group (plant / sensing), as 1 (holds) or 0:
-    nSMERL chatters less than SMC (whole run, both measures), less than SMERL at the motion start, and tracks
-    better than SMC (RMS and max of the joint error). SMERL's and SMC's runs come from group `others` if given
-    (a group that varies only nSMERL)."""
+def claims(m: MetricTable, frame: pd.DataFrame, group: str, others: str | None = None, suffix: str = "") -> None:
+    """The paper's comparisons among the three laws of one group (plant / sensing), as 1 (holds) or 0, under
+    run id `<group><suffix>`: nSMERL chatters less than SMC (whole run, both measures), less than SMERL at the
+    motion start, and tracks better than SMC (RMS and max of the joint error). SMERL's and SMC's runs come from
+    group `others` if given (a group that varies only nSMERL)."""
     def value(law: str, metric: str) -> float:
-        return metric_value(frame, f"{law}-{group if law == 'nsmerl' or others is None else others}", metric)
+        source = group if law == "nsmerl" or others is None else others
+        return metric_value(frame, f"{law}-{source}{suffix}", metric)
 
-    if any(np.isnan(value(law, "e.max")) for law in LAWS):
-        return
-    m.add(group, "claim.less_chattering_than_smc",
+    label = group + suffix
+    if any(np.isnan(value(law, "e.max")) or np.isnan(value(law, "tau.start.tv")) for law in LAWS):
+        return                                   # a law missing, or a run too short for the start window
+    m.add(label, "claim.less_chattering_than_smc",
           float(value("nsmerl", "tau.tv") < value("smc", "tau.tv")
                 and value("nsmerl", "tau.hf_rms") < value("smc", "tau.hf_rms")), "bool")
-    m.add(group, "claim.less_chattering_than_smerl_at_start",
+    m.add(label, "claim.less_chattering_than_smerl_at_start",
           float(value("nsmerl", "tau.start.tv") < value("smerl", "tau.start.tv")
                 and value("nsmerl", "tau.start.hf_rms") < value("smerl", "tau.start.hf_rms")), "bool")
-    m.add(group, "claim.tracks_better_than_smc",
+    m.add(label, "claim.tracks_better_than_smc",
           float(value("nsmerl", "e.rms") < value("smc", "e.rms") and value("nsmerl", "e.max") < value("smc", "e.max")),
           "bool")
     for metric in ("tau.tv", "tau.start.tv", "tau.after.tv", "tau.hf_rms", "e.rms"):
-        m.add(group, f"ratio.smc_over_nsmerl.{metric}", value("smc", metric) / value("nsmerl", metric), "ratio")
-        m.add(group, f"ratio.smerl_over_nsmerl.{metric}", value("smerl", metric) / value("nsmerl", metric), "ratio")
+        m.add(label, f"ratio.smc_over_nsmerl.{metric}", value("smc", metric) / value("nsmerl", metric), "ratio")
+        m.add(label, f"ratio.smerl_over_nsmerl.{metric}", value("smerl", metric) / value("nsmerl", metric), "ratio")
 
 
-def plant_agreement(m: MetricTable, frame: pd.DataFrame) -> None:
+def plant_agreement(m: MetricTable, frame: pd.DataFrame, suffix: str = "") -> None:
     """How far the MuJoCo plant's metrics lie from the analytic plant's, per law (relative)."""
     for law in LAWS:
         for metric in ("e.max", "e.rms", "tau.tv", "tau.hf_rms", "force.y.max"):
-            a, b = metric_value(frame, f"{law}-analytic", metric), metric_value(frame, f"{law}-mujoco", metric)
+            a = metric_value(frame, f"{law}-analytic{suffix}", metric)
+            b = metric_value(frame, f"{law}-mujoco{suffix}", metric)
             if np.isfinite(a) and np.isfinite(b):
-                m.add(f"{law}-plants", f"agreement.{metric}", abs(b - a) / abs(a), "fraction")
+                m.add(f"{law}-plants{suffix}", f"agreement.{metric}", abs(b - a) / abs(a), "fraction")
 
 
 # -- the reaching-time study -------------------------------------------------------------------------------

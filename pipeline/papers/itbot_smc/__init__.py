@@ -27,9 +27,12 @@ from pipeline.papers.itbot_smc.reaching import (
     smerl,
 )
 
-__all__ = ["AnalyticPlant", "Drive", "HandLoad", "JointSensor", "Links", "MujocoPlant", "SlidingModeController",
-           "arm_mjcf", "coriolis", "erl_reaching_time", "fk", "gravity_torque", "ik", "jacobian", "mass_matrix",
-           "mdh_frames", "nsmerl", "proposition_threshold", "reaching_time", "smc", "smerl"]
+SYSTEM_ATTACHMENT = "system.yaml"   # each run's own system config (a case may change the experiment's)
+
+__all__ = ["SYSTEM_ATTACHMENT", "AnalyticPlant", "Drive", "HandLoad", "JointSensor", "Links", "MujocoPlant",
+           "SlidingModeController", "arm_mjcf", "coriolis", "erl_reaching_time", "fk", "gravity_torque", "ik",
+           "jacobian", "mass_matrix", "mdh_frames", "nsmerl", "proposition_threshold", "reaching_time", "smc",
+           "smerl"]
 
 
 def __getattr__(name: str):

@@ -13,7 +13,7 @@ from omegaconf import DictConfig, OmegaConf
 from pipeline.core import markers, schemas
 from pipeline.core.experiment import Case
 from pipeline.core.runlog import RunWriter
-from pipeline.papers.itbot_smc import reaching
+from pipeline.papers.itbot_smc import SYSTEM_ATTACHMENT, reaching
 from pipeline.papers.itbot_smc.closed_loop import ClosedLoopRun, Reference, run_closed_loop
 from pipeline.papers.itbot_smc.controller import JointSensor, SlidingModeController
 from pipeline.papers.itbot_smc.model import JOINTS, Links, fk, mdh_frames
@@ -75,11 +75,9 @@ class Setup:
                            self.period, qd0=self.initial_state()[1])
 
 
-def _stride(log_dt: float, period: float, what: str) -> int:
-    stride = round(log_dt / period)
-    if stride < 1 or abs(stride * period - log_dt) > 1e-9 * log_dt:
-        raise ValueError(f"{what}={log_dt} s must be a whole multiple of the control period {period} s")
-    return stride
+def _stride(log_dt: float, period: float) -> int:
+    """Ticks between logged samples: `log_dt` rounded to whole control periods (at least one)."""
+    return max(1, round(log_dt / period))
 
 
 def world_from_base(configuration: str, drawing) -> np.ndarray:
@@ -94,7 +92,7 @@ def log_run(log: RunWriter, setup: Setup, execute: DictConfig, law: str, run: Cl
     """Every tick: torques, the hand force, the sliding variable, the controller's time; every `log_dt`:
     states, references, errors; every `tf_dt`: the link frames."""
     links = setup.links
-    fine = slice(None, None, _stride(execute.log_dt, setup.period, "execute.log_dt"))
+    fine = slice(None, None, _stride(execute.log_dt, setup.period))
     t, q, qd = run.t[fine], run.q[fine], run.qd[fine]
     q_d, qd_d, qdd_d = setup.reference(t)
     joints = list(JOINTS)
@@ -115,7 +113,7 @@ def log_run(log: RunWriter, setup: Setup, execute: DictConfig, law: str, run: Cl
     log.log_series("/command", run.t, kind="torque", name=joints, value=run.tau)
     log.log_series("/sliding_variable", run.t, schemas.Scalars, name=joints, value=run.v)
     log.log_series("/compute_time", run.t, name=[law], seconds=run.controller_s[:, None], calls=[1])
-    tf = slice(None, None, _stride(execute.tf_dt, setup.period, "execute.tf_dt"))
+    tf = slice(None, None, _stride(execute.tf_dt, setup.period))
     log.log_transforms(run.t[tf], "world", list(TF_FRAMES), frames_in_world(setup, run.q[tf], run.t[tf]))
 
 
@@ -133,6 +131,7 @@ def simulate_case(log: RunWriter, system: DictConfig, execute: DictConfig, law: 
     setup = Setup.of(system)
     xml = setup.mjcf()
     log.attach("model.xml", xml, "application/xml")
+    log.attach(SYSTEM_ATTACHMENT, OmegaConf.to_yaml(system, resolve=True), "application/yaml")
     import mujoco
 
     log.write("/markers", 0, schemas.SceneUpdate(entities=markers.from_mujoco(mujoco.MjModel.from_xml_string(xml))))
