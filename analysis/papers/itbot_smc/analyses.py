@@ -67,8 +67,7 @@ def analyze_smc_sweep(runs: list[Run], figures: Figures) -> pd.DataFrame:
         values = closed_loop_metrics(run, detail=False, forces=False)
         for metric, (value, unit) in values.items():
             m.add(run.run_id, metric, value, unit, params)
-        K = control["K"] if smc["K"] is None else smc["K"]
-        rows.append({**params, "K1": float(K[0]) * params["gain_scale"],
+        rows.append({**params, "K1": float(control["K"][0]) * params["gain_scale"],
                      **{k: v for k, (v, _) in values.items()}})
     if rows:
         fig.sweep_figure(pd.DataFrame(rows).drop_duplicates(["gain_scale", "boundary_layer"]), figures)
@@ -101,3 +100,7 @@ def analyze_reaching_time(runs: list[Run], figures: Figures) -> pd.DataFrame:
     if runs:
         fig.reaching_figure({run.metadata["case"]: run for run in runs}, figures)
     return m.frame()
+
+
+ANALYSES = {"tracking": analyze_tracking, "smc-sweep": analyze_smc_sweep, "load-support": analyze_load_support,
+            "reaching-time": analyze_reaching_time}

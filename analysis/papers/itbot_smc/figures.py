@@ -6,8 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from analysis.core.figures import Figures, plt
+from analysis.core.figures import Figures, paper_hline, paper_vline, plt
 from analysis.core.signals import low_pass
+from analysis.core.targets import paper_value
 from pipeline.core.runlog import Run
 from pipeline.papers.itbot_smc.model import JOINTS
 
@@ -16,8 +17,17 @@ LABELS = {"nsmerl": "nSMERL", "smerl": "SMERL", "smc": "SMC"}
 STYLES = {"nsmerl": "-", "smerl": "--", "smc": "-."}
 ZOOM = (0.0, 0.05)           # s: the start of the motion, where ω(t) acts (50 ticks: each switch visible)
 ENVELOPE = 10                # ticks per min/max window of the whole-run torque panels
-PAPER_FORCE = {"x": 14.0, "y": 10.0}   # N, Sec. 5.2 (Fig. 11)
-BOUND_DEG = 2.0              # Sec. 5.2
+SLUG = "itbot-smc"
+
+
+def _bound_deg() -> float:
+    """The paper's error goal, Sec. 5.2 (targets.csv)."""
+    return paper_value(SLUG, "err.nsmerl", "deg")
+
+
+def _paper_force(axis: str) -> float:
+    """The paper's peak hand force along x or y, Sec. 5.2 / Fig. 11 (targets.csv)."""
+    return paper_value(SLUG, f"force.f{axis}", "N")
 
 
 def _deg(x) -> np.ndarray:
@@ -67,11 +77,12 @@ def joint_figures(runs: dict[str, Run], figures: Figures, where: str) -> None:
                            label=LABELS[law])
             errors[i].plot(t, _deg(e[f"error.{j}"].to_numpy()), STYLES[law], color=COLORS[law], lw=0.8,
                            label=LABELS[law])
+    bound = _bound_deg()
     for i, j in enumerate(JOINTS):
         angles[i].set_ylabel(f"θ{i + 1} [°]")
         errors[i].set_ylabel(f"e{i + 1} = θ{i + 1},d − θ{i + 1} [°]")
-        errors[i].axhline(BOUND_DEG, color="0.5", lw=0.8, ls="--", label="paper: < 2°")
-        errors[i].axhline(-BOUND_DEG, color="0.5", lw=0.8, ls="--")
+        paper_hline(errors[i], bound, label=f"paper: |e| < {bound:g}°")
+        paper_hline(errors[i], -bound, label=None)
         for ax in (angles[i], errors[i]):
             ax.set_xlabel("time [s]")
             ax.set_title(j)
@@ -124,9 +135,9 @@ def force_figure(runs: dict[str, Run], figures: Figures, where: str) -> None:
             ax.plot(t, force, color=COLORS[law], lw=0.3, alpha=0.25)
             ax.plot(t, low_pass(t, force), STYLES[law], color=COLORS[law], lw=1.2, label=f"{LABELS[law]} (< 10 Hz)")
     for ax, axis in zip(axes, ("x", "y"), strict=True):
+        peak = _paper_force(axis)
         for sign in (1, -1):
-            ax.axhline(sign * PAPER_FORCE[axis], color="k", ls=":", lw=1,
-                       label=f"paper: |F{axis}| ≈ {PAPER_FORCE[axis]:g} N" if sign == 1 else None)
+            paper_hline(ax, sign * peak, label=f"paper: |F{axis}| ≈ {peak:g} N" if sign == 1 else None)
         ax.set_xlabel("time [s]")
         ax.set_ylabel(f"F{axis} [N] (hand on handle, frame 0)")
         ax.legend(fontsize=7, ncol=2)
@@ -159,7 +170,7 @@ def sweep_figure(frame: pd.DataFrame, figures: Figures) -> None:
         label = "sign" if layer == 0 else f"sat, Φ = {layer:g} rad/s"
         err.plot(part["K1"], _deg(part["e.max"]), "o-", label=label)
         tv.plot(part["K1"], part["tau.tv"], "o-", label=label)
-    err.axhline(BOUND_DEG, color="0.5", ls="--", lw=0.8, label="paper: < 2°")
+    paper_hline(err, _bound_deg(), label="paper: < 2°")
     gains = sorted(frame["K1"].unique())
     for ax in (err, tv):
         ax.set_xscale("log")
@@ -177,14 +188,14 @@ def sweep_figure(frame: pd.DataFrame, figures: Figures) -> None:
 def support_figure(frame: pd.DataFrame, figures: Figures) -> None:
     """Peak hand forces and the max joint error against the share of the load the subject carries."""
     fig, (force, err) = plt.subplots(1, 2, figsize=(11, 3.6))
-    for axis, color in (("x", "C0"), ("y", "C1")):
+    for axis, color, style in (("x", "C0", "--"), ("y", "C1", ":")):
         force.plot(frame["support"], frame[f"force.{axis}.max"], "o-", color=color, label=f"max |F{axis}|")
-        force.axhline(PAPER_FORCE[axis], color=color, ls=":", lw=1, label=f"paper: {PAPER_FORCE[axis]:g} N")
+        paper_hline(force, _paper_force(axis), label=f"paper: |F{axis}| ≈ {_paper_force(axis):g} N", ls=style)
     force.set_xlabel("share of the load (weight + arm) the subject carries")
     force.set_ylabel("peak hand force [N]")
     force.legend(fontsize=7)
     err.plot(frame["support"], _deg(frame["e.max"]), "o-", color="C3")
-    err.axhline(BOUND_DEG, color="0.5", ls="--", lw=0.8, label="paper: < 2°")
+    paper_hline(err, _bound_deg(), label="paper: < 2°")
     err.set_xlabel("share of the load the subject carries")
     err.set_ylabel("max joint error [°] (nSMERL)")
     err.legend(fontsize=7)
@@ -207,8 +218,7 @@ def reaching_figure(studies: dict[str, Run], figures: Figures) -> None:
         for name, style, label in (("eq7", "k-", "eq. (7)"), ("eq14", "k--", "bound (14)"),
                                    ("eq13", "m:", "eq. (13), ω = 1"), ("eq21", "c-.", "eq. (21), ω → 0")):
             ax.plot(v0, study[f"value.{name}"], style, lw=1, label=label)
-        ax.axvline(gains["value.threshold"], color="0.4", lw=0.8, ls=":")
-        ax.text(gains["value.threshold"], ax.get_ylim()[1], " (1−ϕ)^(−1/ϕ), eq. (27)", fontsize=7, va="top")
+        paper_vline(ax, paper_value(SLUG, "reach.threshold"), label="paper: threshold (1−ϕ)^(−1/ϕ), eq. (27)")
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("|v(0)| [rad/s]")

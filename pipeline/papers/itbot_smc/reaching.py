@@ -34,7 +34,7 @@ class LawGains:
     alpha: np.ndarray      # α_i > 0
     p: np.ndarray          # p_i > 0
     power: float           # ϕ, 0 < ϕ < 0.5 (Table 3's "Φ")
-    smc_K: np.ndarray      # rad/s², the conventional SMC's gain (not given: Table 3's K unless overridden)
+    smc_K: np.ndarray      # rad/s², the conventional SMC's gain (not given: Table 3's K × gain_scale)
     boundary_layer: float  # rad/s, Φ of sat(v/Φ); 0 = sign (the paper's SMC)
     omega_rate: float = 1.0  # 1/s: ω = 1/(1 + (c t)²) with t in s; c = 1000 reads eq. (6)'s t_i in milliseconds
 
@@ -46,9 +46,8 @@ class LawGains:
 
     @classmethod
     def from_config(cls, control) -> LawGains:
-        smc_K = _array(control.smc.K if control.smc.K is not None else control.K)
         return cls(K=_array(control.K), phi=_array(control.phi), alpha=_array(control.alpha), p=_array(control.p),
-                   power=float(control.power), smc_K=smc_K * float(control.smc.gain_scale),
+                   power=float(control.power), smc_K=_array(control.K) * float(control.smc.gain_scale),
                    boundary_layer=float(control.smc.boundary_layer), omega_rate=float(control.omega_rate))
 
 
