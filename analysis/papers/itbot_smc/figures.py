@@ -94,13 +94,14 @@ def joint_figures(runs: dict[str, Run], figures: Figures, where: str) -> None:
     figures.save(fig9, "fig9-joint-errors")
 
 
-def _torque_band(ax, t: np.ndarray, tau: np.ndarray, color: str, style: str, label: str) -> None:
-    """A chattering torque: the band it switches in (min-max per ENVELOPE ticks) and its part below 10 Hz."""
+def _band(ax, t: np.ndarray, u: np.ndarray, color: str, style: str, label: str | None) -> None:
+    """A chattering signal: the band it switches in (min-max per ENVELOPE ticks) and its part below 10 Hz (drawn
+    every ENVELOPE ticks: it is smooth)."""
     blocks = len(t) // ENVELOPE
-    chunks = tau[:blocks * ENVELOPE].reshape(blocks, ENVELOPE)
+    chunks = u[:blocks * ENVELOPE].reshape(blocks, ENVELOPE)
     ax.fill_between(t[:blocks * ENVELOPE:ENVELOPE], chunks.min(axis=1), chunks.max(axis=1), color=color, alpha=0.2,
                     lw=0)
-    ax.plot(t, low_pass(t, tau), style, color=color, lw=1.1, label=label)
+    ax.plot(t[::ENVELOPE], low_pass(t, u)[::ENVELOPE], style, color=color, lw=1.1, label=label)
 
 
 def torque_figure(runs: dict[str, Run], figures: Figures, where: str, name: str, number: str = "10") -> None:
@@ -113,7 +114,7 @@ def torque_figure(runs: dict[str, Run], figures: Figures, where: str, name: str,
         zoom = (t >= ZOOM[0]) & (t <= ZOOM[1])
         for i, j in enumerate(JOINTS):
             tau = command[f"value.{j}"].to_numpy()
-            _torque_band(axes[i, 0], t, tau, COLORS[law], STYLES[law], LABELS[law])
+            _band(axes[i, 0], t, tau, COLORS[law], STYLES[law], LABELS[law])
             axes[i, 1].plot(t[zoom], tau[zoom], STYLES[law], color=COLORS[law], lw=0.9, drawstyle="steps-post")
             axes[i, 0].set_ylabel(f"τ{i + 1} [N m]")
     axes[1, 0].set_xlabel("time [s] (line: below 10 Hz; band: min-max per 10 ms)")
@@ -124,16 +125,14 @@ def torque_figure(runs: dict[str, Run], figures: Figures, where: str, name: str,
 
 
 def force_figure(runs: dict[str, Run], figures: Figures, where: str) -> None:
-    """Fig. 11: the force of the hand on the handle (every tick, light; below 10 Hz, dark), with the paper's
-    peaks."""
+    """Fig. 11: the force of the hand on the handle (its band, min-max per 10 ms; below 10 Hz, lines), with the
+    paper's peaks."""
     fig, axes = plt.subplots(1, 2, figsize=(11, 3.6))
     for law, run in runs.items():
         wrench = run["/wrench"]
         t = wrench.index.to_numpy()
         for ax, axis in zip(axes, ("x", "y"), strict=True):
-            force = wrench[f"force_{axis}.hand"].to_numpy()
-            ax.plot(t, force, color=COLORS[law], lw=0.3, alpha=0.25)
-            ax.plot(t, low_pass(t, force), STYLES[law], color=COLORS[law], lw=1.2, label=f"{LABELS[law]} (< 10 Hz)")
+            _band(ax, t, wrench[f"force_{axis}.hand"].to_numpy(), COLORS[law], STYLES[law], f"{LABELS[law]} (< 10 Hz)")
     for ax, axis in zip(axes, ("x", "y"), strict=True):
         peak = _paper_force(axis)
         for sign in (1, -1):
@@ -153,7 +152,7 @@ def plant_figure(analytic: Run, mujoco: Run, figures: Figures, law: str) -> None
         t = command.index.to_numpy()
         for i, j in enumerate(JOINTS):
             axes[0, i].plot(e.index, _deg(e[f"error.{j}"]), style, color=color, lw=0.8, label=label)
-            _torque_band(axes[1, i], t, command[f"value.{j}"].to_numpy(), color, style, label)
+            _band(axes[1, i], t, command[f"value.{j}"].to_numpy(), color, style, label)
             axes[0, i].set_ylabel(f"e{i + 1} [°]")
             axes[1, i].set_ylabel(f"τ{i + 1} [N m] (line: < 10 Hz; band: min-max per 10 ms)")
             axes[1, i].set_xlabel("time [s]")
