@@ -122,3 +122,21 @@ def test_one_rk4_step_per_period_is_converged(setup):
     runs = [run_closed_loop(setup.plant("analytic", n), setup.controller("nsmerl"), setup.sensor(), reference,
                             setup.period, setup.drive.torque_limit) for n in (1, 10)]
     assert np.abs(runs[0].q - runs[1].q).max() < 1e-5
+
+
+def test_tf_frames_are_the_mujoco_body_frames(setup):
+    """What /tf publishes (the MDH frames placed in the world) is where MuJoCo has the bodies the /markers
+    entities are attached to, so the robot draws right in Foxglove."""
+    from pipeline.papers.itbot_smc.experiments import TF_FRAMES, frames_in_world
+
+    model = mujoco.MjModel.from_xml_string(setup.mjcf())
+    data = mujoco.MjData(model)
+    q = RNG.uniform(-1.4, 1.4, (5, 2))
+    frames = frames_in_world(setup, q, np.zeros(len(q)))
+    for k in range(len(q)):
+        data.qpos[:] = q[k]
+        mujoco.mj_kinematics(model, data)
+        for i, name in enumerate(TF_FRAMES[:4]):
+            body = model.body(name).id
+            assert np.allclose(frames[k, i, :3, 3], data.xpos[body], atol=1e-12), name
+            assert np.allclose(frames[k, i, :3, :3], data.xmat[body].reshape(3, 3), atol=1e-12), name
