@@ -18,7 +18,8 @@ SHORT = ["system.reference.period=2.5", "progress=false"]
 
 @pytest.mark.slow
 def test_every_experiment_to_the_report(data_dir):
-    for experiment, extra in (("tracking", SHORT), ("load-support", SHORT),
+    one_load = ["scenario.supports=[0.5]", "scenario.paper_model_laws=[smerl]"]
+    for experiment, extra in (("tracking", SHORT), ("load-support", [*SHORT, *one_load]),
                               ("smc-sweep", [*SHORT, "system.control.smc.boundary_layer=0.5"]),
                               ("reaching-time", ["progress=false"])):
         proc = run_cli("pipeline", f"experiment={SLUG}/{experiment}", f"data_dir={data_dir}", *extra)
