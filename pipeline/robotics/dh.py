@@ -1,6 +1,7 @@
-"""Standard (distal) Denavit–Hartenberg kinematics, vectorized over any leading batch shape.
+"""Denavit–Hartenberg kinematics, vectorized over any leading batch shape.
 
-    ^{i-1}T_i = Rz(θ_i + θ_offset_i) · Tz(d_i) · Tx(a_i) · Rx(α_i)
+    standard (distal):         ^{i-1}T_i = Rz(θ_i + θ_offset_i) · Tz(d_i) · Tx(a_i) · Rx(α_i)
+    modified (proximal, Craig): ^{i-1}T_i = Rx(α_{i-1}) · Tx(a_{i-1}) · Rz(θ_i) · Tz(d_i)   (link transform only)
 """
 
 from __future__ import annotations
@@ -72,3 +73,21 @@ def geometric_jacobian(dh: DH, q: np.ndarray) -> np.ndarray:
     p_e = F[..., -1:, :3, 3]
     J = np.concatenate([np.cross(z, p_e - p), z], axis=-1)  # (..., n, 6)
     return np.swapaxes(J, -1, -2)
+
+
+def modified_link_transforms(alpha: np.ndarray, a: np.ndarray, d: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """(..., n, 4, 4): ^{i-1}T_i of a modified (proximal, Craig) DH table, broadcast over leading axes of `theta`.
+
+        ^{i-1}T_i = Rx(α_{i-1}) · Tx(a_{i-1}) · Rz(θ_i) · Tz(d_i)
+
+    Row i holds α_{i-1}, a_{i-1}, d_i and the full joint angle θ_i (offsets included)."""
+    theta = np.asarray(theta, dtype=float)
+    ct, st = np.cos(theta), np.sin(theta)
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    ca, sa, a, d = (np.broadcast_to(np.asarray(x, dtype=float), theta.shape) for x in (ca, sa, a, d))
+    T = np.zeros((*theta.shape, 4, 4))
+    T[..., 0, 0], T[..., 0, 1], T[..., 0, 3] = ct, -st, a
+    T[..., 1, 0], T[..., 1, 1], T[..., 1, 2], T[..., 1, 3] = st * ca, ct * ca, -sa, -sa * d
+    T[..., 2, 0], T[..., 2, 1], T[..., 2, 2], T[..., 2, 3] = st * sa, ct * sa, ca, ca * d
+    T[..., 3, 3] = 1.0
+    return T
