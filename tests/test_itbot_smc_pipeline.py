@@ -4,6 +4,7 @@ before anything is written."""
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -18,7 +19,7 @@ SHORT = ["system.reference.period=2.5", "progress=false"]
 
 @pytest.mark.slow
 def test_every_experiment_to_the_report(data_dir):
-    one_load = ["scenario.supports=[0.5]", "scenario.paper_model_laws=[smerl]"]
+    one_load = ["system.hand.support=1", "scenario.paper_model_laws=[smerl]"]   # with the bare model
     for experiment, extra in (("tracking", SHORT), ("load-support", [*SHORT, *one_load]),
                               ("smc-sweep", [*SHORT, "system.control.smc.boundary_layer=0.5"]),
                               ("reaching-time", ["progress=false"])):
@@ -34,7 +35,12 @@ def test_every_experiment_to_the_report(data_dir):
     assert run.ok
     assert {"/joint_state", "/reference", "/command", "/tracking_error", "/wrench", "/compute_time", "/tf",
             "/markers", "/sliding_variable"} <= set(run.topic_names)
-    assert {"model.xml", "config.yaml"} <= set(run.attachments)
+    assert {"model.xml", "config.yaml", "robot.urdf"} <= set(run.attachments)   # the arm drawn from its model
+    assert {"/robot_description", "/joint_states", "/tf/robot"} <= set(run.topic_names)
+    arrow = run["/markers"].filter(like="arrows.0.")                     # the hand's force at 5 mm/N
+    drawn = (arrow.filter(like="shaft_length").iloc[:, 0] + arrow.filter(like="head_length").iloc[:, 0]) / 0.005
+    wrench = run["/wrench"].reindex(drawn.index)
+    assert len(drawn) > 100 and np.allclose(drawn, np.hypot(wrench["force_x.hand"], wrench["force_y.hand"]))
     assert {"position.joint1", "position.joint2"} <= set(run["/joint_state"].columns)
     assert len(run["/command"]) == 2500                                   # every tick of the 2.5 s exercise
     assert {"transforms.link2.translation.x", "transforms.hand.translation.x"} <= set(run["/tf"].columns)

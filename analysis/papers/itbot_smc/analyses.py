@@ -75,21 +75,19 @@ def analyze_smc_sweep(runs: list[Run], figures: Figures) -> pd.DataFrame:
 
 
 def analyze_load_support(runs: list[Run], figures: Figures) -> pd.DataFrame:
+    """Per run its metrics with the share it was run at (the band of the force targets is the core's: every
+    `<law>-<plant>__system.hand.support=s` run); the figure draws the peaks against the share."""
     m = MetricTable()
     rows = []
     for run in runs:
         values = closed_loop_metrics(run, detail=False)
-        m.add_run(run, values)
-        if run.metadata["case"].startswith("support-"):
-            rows.append({"support": float(system_of(run)["hand"]["support"]),
-                         **{k: v for k, (v, _) in values.items()}})
+        support = float(system_of(run)["hand"]["support"])
+        for metric, (value, unit) in values.items():
+            m.add(run.run_id, metric, value, unit, {**run.params, "support": support})
+        if not run.metadata["case"].startswith("paper-model-"):
+            rows.append({"support": support, **{k: v for k, (v, _) in values.items()}})
     if rows:
-        band = pd.DataFrame(rows).sort_values("support")
-        for axis in ("x", "y"):
-            peaks = band[f"force.{axis}.max"]
-            m.add("band", f"force.{axis}.max.min", float(peaks.min()), "N")
-            m.add("band", f"force.{axis}.max.max", float(peaks.max()), "N")
-        fig.support_figure(band, figures)
+        fig.support_figure(pd.DataFrame(rows).drop_duplicates("support").sort_values("support"), figures)
     return m.frame()
 
 

@@ -43,8 +43,8 @@ def system_of(run: Run) -> dict:
 
 
 def law_of(run: Run) -> str:
-    """The reaching law of a closed-loop run (its case id starts with it, or it is the sweep's SMC)."""
-    return run.metadata["case"].split("-")[0] if run.metadata["case"].split("-")[0] in LAWS else "smc"
+    """The reaching law of a closed-loop run, named in its case: `<law>-<plant or group>`, `paper-model-<law>`."""
+    return next(part for part in run.metadata["case"].split("-") if part in LAWS)
 
 
 def closed_loop_metrics(run: Run, detail: bool = True, forces: bool = True) -> dict[str, tuple[float, str]]:

@@ -91,15 +91,19 @@ def sweep_section(frame: pd.DataFrame, runs: pd.DataFrame) -> Section:
 
 
 def support_section(frame: pd.DataFrame) -> Section:
-    rows = [{"run": run_id, "max |e| [°]": metric_value(frame, run_id, "e.max") * DEG,
+    shares = frame.groupby("run_id")["support"].first() if "support" in frame else pd.Series(dtype=float)
+    order = sorted(set(frame["run_id"]), key=lambda r: (r.startswith("paper-model"), shares.get(r, 0), r))
+    rows = [{"run": run_id, "share carried": shares.get(run_id, float("nan")),
+             "max |e| [°]": metric_value(frame, run_id, "e.max") * DEG,
              "peak |Fx| [N]": metric_value(frame, run_id, "force.x.max"),
              "peak |Fy| [N]": metric_value(frame, run_id, "force.y.max"),
              "TV [N m/s]": metric_value(frame, run_id, "tau.tv")}
-            for run_id in sorted(set(frame["run_id"]) - {"band"})]
+            for run_id in order]
     return Section("The load on the handle (Fig. 11's peaks)",
-                   "`support-s`: nSMERL with the subject carrying the share s of the 11 lb weight and the arm (the "
-                   "controller's model knows it); `paper-model-<law>`: the controller uses eqs. (A8)-(A10) alone while "
-                   "the subject carries all the weight, so only the load's inertia, the drive and its friction are "
+                   "`nsmerl-analytic__system.hand.support=s`: the tracking experiment's nSMERL run with the subject "
+                   "carrying the share s of the 11 lb weight and the arm (the controller's model knows it), the band "
+                   "of the force targets; `paper-model-<law>`: the controller uses eqs. (A8)-(A10) alone while the "
+                   "subject carries all the weight, so only the load's inertia, the drive and its friction are "
                    "unknown to it (a missing row: the run failed, see Runs). The paper measured Fx ≈ 14 N, Fy ≈ 10 N.",
                    Table(pd.DataFrame(rows)), category="force errors")
 

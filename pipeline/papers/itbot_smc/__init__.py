@@ -80,7 +80,7 @@ LIMITS: dict[str, Limit | tuple[Limit, ...]] = {
                                                        "motor_length", "handle_radius", "handle_length",
                                                        "weight_radius")},
     "scenario.laws": (Length(1, 3), LAWS), "scenario.paper_model_laws": (Length(0, 3), LAWS), "scenario.law": LAWS,
-    "scenario.plant": PLANTS, "scenario.supports": (Length(1, 21), PROBABILITY),
+    "scenario.plant": PLANTS,
     **{f"scenario.groups.{g}.{k}": allowed for g in GROUPS for k, allowed in (
         ("plant", PLANTS), ("sensing", OneOf(("ideal", "hall"))), ("omega_rate", Range(gt=0, le=1e6)),
         ("laws", (Length(0, 3), LAWS)))},
@@ -110,7 +110,7 @@ BUDGETS = {
         len(g.laws) or len(c.scenario.laws) for g in c.scenario.groups.values()), _TICKS, _HINT),
     "smc-sweep": Budget("control ticks", _ticks_per_run, _TICKS, _HINT),
     "load-support": Budget("control ticks", lambda c: _ticks_per_run(c) * (
-        len(c.scenario.supports) + len(c.scenario.paper_model_laws)), _TICKS, _HINT),
+        1 + len(c.scenario.paper_model_laws) * (float(c.system.hand.support) == 1.0)), _TICKS, _HINT),
     "reaching-time": Budget("reaching times", lambda c: 4.0 * c.scenario.points * len(c.scenario.joints)
                             * len(c.scenario.alphas), 2e4, "fewer scenario.points, joints or alphas"),
 }

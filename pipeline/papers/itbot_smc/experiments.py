@@ -10,9 +10,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
-from pipeline.core import markers, schemas
+from pipeline.core import markers, robot, schemas
 from pipeline.core.experiment import Case
-from pipeline.core.runlog import RunWriter
+from pipeline.core.runlog import RunWriter, seconds_to_ns
 from pipeline.papers.itbot_smc import SYSTEM_ATTACHMENT, reaching
 from pipeline.papers.itbot_smc.closed_loop import ClosedLoopRun, Reference, run_closed_loop
 from pipeline.papers.itbot_smc.controller import JointSensor, SlidingModeController
@@ -23,6 +23,7 @@ from pipeline.papers.itbot_smc.reaching import LawGains
 
 HAND_AXES = ("x", "y")
 TF_FRAMES = ("base", "link1", "link2", "hand", "hand_reference")
+FORCE_RGBA, FORCE_SCALE = (0.95, 0.5, 0.1, 1.0), 0.005  # the hand's force drawn at 5 mm/N
 
 
 @dataclass(frozen=True)
@@ -114,7 +115,21 @@ def log_run(log: RunWriter, setup: Setup, execute: DictConfig, law: str, run: Cl
     log.log_series("/sliding_variable", run.t, schemas.Scalars, name=joints, value=run.v)
     log.log_series("/compute_time", run.t, name=[law], seconds=run.controller_s[:, None], calls=[1])
     tf = slice(None, None, _stride(execute.tf_dt, setup.period))
-    log.log_transforms(run.t[tf], "world", list(TF_FRAMES), frames_in_world(setup, run.q[tf], run.t[tf]))
+    frames = frames_in_world(setup, run.q[tf], run.t[tf])
+    log.log_transforms(run.t[tf], "world", list(TF_FRAMES), frames)
+    log_force_arrows(log, run.t[tf], frames, force[tf])
+
+
+def log_force_arrows(log: RunWriter, t: np.ndarray, frames: np.ndarray, force_base: np.ndarray) -> None:
+    """The hand's force on the handle (N, in frame 0) as an arrow from the /tf frame `hand`, thinned to the
+    viewers' rate: the robot itself is drawn from the attached model (robot.urdf, from /joint_state)."""
+    keep = robot.thinned(t)
+    world_from_hand, world_from_base = frames[keep, 3, :3, :3], frames[keep, 0, :3, :3]
+    f_base = np.column_stack([force_base[keep], np.zeros(len(keep))])
+    f_hand = np.einsum("nji,njk,nk->ni", world_from_hand, world_from_base, f_base)
+    for t_k, f_k in zip(t[keep], f_hand, strict=True):
+        log.write("/markers", seconds_to_ns(t_k), schemas.SceneUpdate(entities=[markers.arrow(
+            "hand_force", "hand", f_k, FORCE_RGBA, scale=FORCE_SCALE)]))
 
 
 def frames_in_world(setup: Setup, q: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -132,9 +147,6 @@ def simulate_case(log: RunWriter, system: DictConfig, execute: DictConfig, law: 
     xml = setup.mjcf()
     log.attach("model.xml", xml, "application/xml")
     log.attach(SYSTEM_ATTACHMENT, OmegaConf.to_yaml(system, resolve=True), "application/yaml")
-    import mujoco
-
-    log.write("/markers", 0, schemas.SceneUpdate(entities=markers.mujoco_geoms(mujoco.MjModel.from_xml_string(xml))))
     plant = setup.plant(plant_kind, int(execute.substeps))
     run = run_closed_loop(plant, setup.controller(law), setup.sensor(), setup.reference, setup.period,
                           setup.drive.torque_limit)
@@ -169,22 +181,27 @@ def tracking(cfg: DictConfig) -> list[Case]:
 
 
 def smc_sweep(cfg: DictConfig) -> list[Case]:
-    return [Case("smc", lambda log: simulate_case(log, cfg.system, cfg.execute, "smc", cfg.scenario.plant))]
+    """The tracking experiment's `smc-<plant>` run at one grid point: its sweep runs `smc-<plant>__<overrides>`
+    are the band of the SMC targets."""
+    plant = cfg.scenario.plant
+    return [Case(f"smc-{plant}", lambda log: simulate_case(log, cfg.system, cfg.execute, "smc", plant))]
 
 
-# -- the share of the load the subject carries: the force comparison ----------------------------------------
+# -- the share of the load the subject carries: the force comparison (a Hydra sweep of system.hand.support) -----
 
 
 def load_support(cfg: DictConfig) -> list[Case]:
-    """nSMERL with the subject carrying a share s of the load (the controller's model knows it, as the handle's
-    force sensor reads it at rest); and the paper's bare model (A8)-(A10), without the load, under each law
-    while the subject carries all of it (`paper-model-<law>`): only the load's inertia is then unknown."""
+    """The tracking experiment's `<law>-<plant>` run with the subject carrying the share system.hand.support of
+    the load (the controller's model knows it, as the handle's force sensor reads it at rest): its sweep runs
+    `<law>-<plant>__system.hand.support=s` are the band of the force targets. Where the subject carries all of
+    it (support 1), also the paper's bare model (A8)-(A10), without the load, under each law
+    (`paper-model-<law>`): only the load's inertia is then unknown to the controller."""
     sc, ex = cfg.scenario, cfg.execute
-    cases = [Case(f"support-{s:g}", lambda log, s=float(s): simulate_case(
-        log, _with(cfg.system, {"hand.support": s}), ex, sc.law, sc.plant)) for s in sc.supports]
-    bare = _with(cfg.system, {"hand.support": 1.0, "control.model.hand_load": False})
-    cases += [Case(f"paper-model-{law}", lambda log, law=law: simulate_case(log, bare, ex, law, sc.plant))
-              for law in sc.paper_model_laws]
+    cases = [Case(f"{sc.law}-{sc.plant}", lambda log: simulate_case(log, cfg.system, ex, sc.law, sc.plant))]
+    if float(cfg.system.hand.support) == 1.0:
+        bare = _with(cfg.system, {"control.model.hand_load": False})
+        cases += [Case(f"paper-model-{law}", lambda log, law=law: simulate_case(log, bare, ex, law, sc.plant))
+                  for law in sc.paper_model_laws]
     return cases
 
 
