@@ -68,6 +68,7 @@ def test_runs_carry_the_replay(data, tmp_path):
     assert urdf.count("<box ") == 1 and 'name="joint1"' in urdf and 'name="joint2"' in urdf
     bench = read_run(data / "runs" / "kinematic-graph" / "search" / "benchmark-obstacle.mcap")
     assert bench["/markers"].filter(like="cubes.0.size.x").iloc[0].tolist() == pytest.approx([0.1])
+    assert run["/markers"].filter(like="cubes.0.size.x").iloc[0].tolist() == pytest.approx([0.1])  # and beside the arm
     assert list(run["/joint_state"].filter(like="position.").columns) == ["position.joint1", "position.joint2"]
     assert run["/clearance"]["value.executed.min"].min() > -0.01   # the KG plan passes the obstacle
     tonly = read_run(data / "runs" / "kinematic-graph" / "search" / "obstacle-tspace-only.mcap")

@@ -367,10 +367,12 @@ def showcase_case(cfg: DictConfig, arm_name: str, boxes: Boxes, query: Query, me
                                  "mu", "members", "state"],
                            value=np.column_stack([kg.pos, kg.q, world.kg_planner.space.mu, kg.members, state]))
         planned = arm.points(waypoints)[:, -1]
-        # the arm and the obstacles are the attached model's (robot.urdf, drawn from /joint_state)
+        # the arm is the attached model's (robot.urdf, drawn from /joint_state); the obstacles, world geoms of that
+        # model, are scene entities too, as in the benchmark runs
         log.write("/markers", 0, schemas.SceneUpdate(entities=[
             markers.line_strip("plan", planned, thickness=0.006, color=(0.85, 0.1, 0.1, 1.0)),
-            *markers.spheres(["goal"], [0.02], [(0.1, 0.7, 0.2, 1.0)])]))
+            *markers.spheres(["goal"], [0.02], [(0.1, 0.7, 0.2, 1.0)]),
+            *(ex.obstacle_geoms(boxes) if len(boxes) else [])]))
 
     return simulate
 
