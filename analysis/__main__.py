@@ -80,12 +80,21 @@ def main() -> None:
         if code:
             raise SystemExit(code)
 
+    from pipeline.core import stages
+
     interrupts.install()
+    code: int | str | None = 0
     try:
         task()
     except KeyboardInterrupt as err:  # every output is published whole, so nothing half-written is left
         print("interrupted", file=sys.stderr)
-        sys.exit(interrupts.exit_code(err))
+        code = interrupts.exit_code(err)
+    except SystemExit as exit_:
+        code = exit_.code
+    if not runs_nothing(flags):
+        stages.record(stages.argument(overrides, "data_dir", "data"), stages.argument(overrides, "stage", "all"),
+                      stages.argument(overrides, "experiment"), code if isinstance(code, int) else 1)
+    sys.exit(code)
 
 
 if __name__ == "__main__":

@@ -33,6 +33,7 @@ def main() -> None:
 
     import hydra
     from hydra.core.hydra_config import HydraConfig
+    from hydra.types import RunMode
     from omegaconf import DictConfig
 
     from pipeline.core import interrupts
@@ -48,6 +49,8 @@ def main() -> None:
         if worker:  # a sweep worker must not outlive the stage that started it
             interrupts.die_with_parent()
         hc = HydraConfig.get()
+        if hc.mode == RunMode.MULTIRUN:  # the launcher already runs one job per core
+            cfg.workers = 1
         try:
             errors = simulate(cfg, hc.runtime.choices["experiment"], list(hc.overrides.task))
         except BadInput as err:
@@ -60,12 +63,22 @@ def main() -> None:
         if errors:
             raise SystemExit(1)
 
+    from pipeline.core import stages
+
     interrupts.install()
+    code: int | str | None = 0
     try:
         task()
     except KeyboardInterrupt as err:  # Ctrl-C or SIGTERM: the open run was dropped, finished ones stay
         print("interrupted: the run in progress was dropped; finished runs are kept", file=sys.stderr)
-        sys.exit(interrupts.exit_code(err))
+        code = interrupts.exit_code(err)
+    except SystemExit as exit_:
+        code = exit_.code
+    if not runs_nothing(flags):
+        stages.record(stages.argument(overrides, "data_dir", "data"), "simulate",
+                      stages.argument(overrides, "experiment"), code if isinstance(code, int) else 1,
+                      sweep="-m" in flags or "--multirun" in flags)
+    sys.exit(code)
 
 
 if __name__ == "__main__":

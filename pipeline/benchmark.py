@@ -2,6 +2,8 @@
 
     python -m pipeline.benchmark                 every paper that has a benchmark
     python -m pipeline.benchmark ur5-ik-fsm      one paper
+    python -m pipeline.benchmark stages [DIR]    each stage of the last pipeline run under DIR (default data),
+                                                 slowest first: wall, CPU, start-up to the first simulated step
 
 A paper opts in with `pipeline/papers/<module>/benchmark.py` exposing `benchmark() -> list[dict]` (rows with
 what, measure, value, unit, and optionally p95, goal, paper). Timing lives here, never in the tests.
@@ -29,7 +31,29 @@ from pipeline.core.experiment import module_name
 PAPERS = Path(__file__).parent / "papers"
 
 
+def stage_times(data_dir: Path) -> int:
+    from pipeline.core import stages
+
+    entries = stages.read(data_dir)
+    if not entries:
+        print(f"error: no stage has run under {data_dir} (run the pipeline: python -m dvc repro)", file=sys.stderr)
+        return 2
+    table = pd.DataFrame(entries).reindex(columns=["stage", "experiment", "wall_s", "cpu_s", "children_cpu_s",
+                                                   "first_step_s", "first_step_cpu_s", "exit_code"])
+    table["cpu_s"] = table["cpu_s"] + table["children_cpu_s"].fillna(0)  # a stage's workers count too
+    table = table.drop(columns="children_cpu_s")
+    m = provenance.machine()
+    print(f"machine: {m['cpu']}, {m['logical_cores']} logical cores; {len(table)} stages under {data_dir}")
+    print(f"total: wall {table.wall_s.sum():.1f} s (stages one after another), CPU {table.cpu_s.sum():.1f} s; "
+          f"start-up to the first simulated step: median {table.first_step_s.median():.2f} s wall, "
+          f"{table.first_step_cpu_s.median():.2f} s CPU\n")
+    print(table.astype(object).where(table.notna(), "").to_markdown(index=False, floatfmt=".2f"))
+    return 0
+
+
 def main(argv: list[str]) -> int:
+    if argv[:1] == ["stages"]:
+        return stage_times(Path(argv[1] if len(argv) > 1 else "data"))
     available = sorted(p.parent.name.replace("_", "-") for p in PAPERS.glob("*/benchmark.py"))
     slugs = argv or available
     unknown = [s for s in slugs if s not in available]

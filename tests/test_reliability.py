@@ -164,6 +164,32 @@ def test_two_processes_into_one_data_dir_leave_only_complete_runs(tmp_path):
     assert not list((data_dir / "runs").rglob("*.partial"))
 
 
+def test_runs_in_parallel_processes_equal_runs_in_one(tmp_path):
+    """An experiment's cases run one per core: the files hold the same records as when run one by one."""
+    frames = {}
+    for workers in (1, 2):
+        data_dir = tmp_path / f"w{workers}"
+        proc = run_cli("pipeline", "experiment=ur5-ik-fsm/singular-paths", "scenario.paths=[wrist,shoulder]",
+                       "scenario.crossings=[near]", "scenario.duration=0.4", f"data_dir={data_dir}",
+                       f"workers={workers}", "progress=false")
+        assert proc.returncode == 0, proc.stderr
+        runs = [read_run(p) for p in run_files(data_dir / "runs/ur5-ik-fsm/singular-paths")]
+        assert len(runs) == 4 and all(r.ok for r in runs)  # two paths, two algorithms
+        assert {r.metadata["parallel_runs"] for r in runs} == {str(workers)}
+        frames[workers] = {r.run_id: r["/joint_state"] for r in runs}
+    assert frames[1].keys() == frames[2].keys()
+    for rid, frame in frames[1].items():
+        assert frame.equals(frames[2][rid]), rid
+
+
+def test_a_timed_experiment_runs_its_cases_alone(tmp_path):
+    proc = run_cli("pipeline", "experiment=curve-discretization/timing-fig3", "scenario.joint_counts.last=8",
+                   "scenario.repeats=3", "scenario.warmup=1", f"data_dir={tmp_path}", "workers=2", "progress=false")
+    assert proc.returncode == 0, proc.stderr
+    paths = run_files(tmp_path / "runs/curve-discretization/timing-fig3")
+    assert len(paths) > 1 and {read_run(p).metadata["parallel_runs"] for p in paths} == {"1"}
+
+
 def test_temporary_names_are_unique_and_publishing_is_all_or_nothing(tmp_path):
     out = tmp_path / "x.txt"
     assert len({files.temporary_name(out) for _ in range(50)}) == 50
@@ -224,6 +250,7 @@ def test_ctrl_c_during_an_exudyn_run_stops_the_stage(tmp_path):
     assert proc.returncode == 130, stderr
     runs = [read_run(p) for p in run_files(out)]
     assert 1 <= len(runs) < 3 and all(r.ok for r in runs), [r.status for r in runs]
+    assert not list(out.glob(f"*{files.PARTIAL_SUFFIX}"))  # the runs its workers had open are dropped
     assert "interrupted" in stderr
 
 

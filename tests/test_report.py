@@ -323,3 +323,12 @@ def test_full_report_is_honest():
         tol = Tolerance.parse(r.tolerance.replace("(mod 2π)", "wrap"))
         allowed = tol.value * (abs(float(r.paper_value)) if tol.relative else 1.0)
         assert abs(float(r.deviation)) <= CLOSE_FACTOR * allowed * (1 + 1e-9), r.target_id
+
+
+def test_a_caption_may_hold_braces(tmp_path):
+    png = tmp_path / "figures/x/plot-a.png"
+    png.parent.mkdir(parents=True)
+    png.write_bytes(b"")
+    info = {"slug": "x", "figures": {"x/*": {"caption": "Set {q | q > 0} of case {name}", "section": "S"}}}
+    [entry] = report.figure_entries(info, [png], tmp_path)
+    assert entry["caption"] == "Set {q | q > 0} of case plot-a"

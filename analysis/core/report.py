@@ -227,7 +227,7 @@ def figure_entries(info: dict, figures: list[Path], report_dir: Path) -> list[di
             spec = {"paper": None, "caption": "(not declared in paper.yaml)", "section": FURTHER}
         svg = png.with_suffix(".svg")
         entries.append({"experiment": png.parent.name, "name": png.stem, "anchor": anchor("fig", key),
-                        "paper": spec.get("paper"), "caption": str(spec.get("caption", "")).format(name=png.stem),
+                        "paper": spec.get("paper"), "caption": str(spec.get("caption", "")).replace("{name}", png.stem),
                         "section": spec.get("section", FURTHER), "png": os.path.relpath(png, report_dir),
                         "svg": os.path.relpath(svg if svg.is_file() else png, report_dir)})
     return entries

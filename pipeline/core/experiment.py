@@ -6,11 +6,16 @@ A paper package `pipeline.papers.<slug with _>` exports
     LIMITS: dict[str, Limit | tuple[Limit, ...]]   # per dotted key: ranges, choices, list lengths, free text
     RULES: list[Rule]                              # constraints between parameters (optional)
     BUDGETS: dict[str, Budget]                     # experiment name -> cost estimate and its limit (optional)
+    TIMED: frozenset[str]                          # experiments whose compute times the paper's are compared with
 
-An experiment turns its resolved config into cases; each case is one run, one MCAP file. Everything declared
-here is checked before anything runs (pipeline.core.checks): the declarations sit beside the experiments
-they guard, and tests/test_reliability.py checks that every choice, size, count, duration and time step of
-every experiment is covered.
+An experiment turns its resolved config into cases; each case is one run, one MCAP file. The cases of an
+experiment run in parallel, one process per core, unless it is TIMED: then they run one after another, alone
+on the machine (DVC runs one stage at a time), so no other run shares a core with a measurement. Every run
+records how many ran beside it (`parallel_runs`), for the compute times other experiments log in passing.
+
+Everything declared here is checked before anything runs (pipeline.core.checks): the declarations sit beside
+the experiments they guard, and tests/test_reliability.py checks that every choice, size, count, duration and
+time step of every experiment is covered.
 """
 
 from __future__ import annotations
@@ -129,6 +134,7 @@ class Experiment:
     limits: dict[str, Limit | tuple[Limit, ...]] = field(default_factory=dict)
     rules: tuple[Rule, ...] = ()
     budget: Budget | None = None
+    timed: bool = False
 
     @property
     def id(self) -> str:
@@ -144,7 +150,7 @@ ANGLE = Range(ge=-2 * math.pi, le=2 * math.pi)
 NAMED_LIMITS: dict[str, Range] = {
     **dict.fromkeys(("dt", "mass", "masses", "inertia", "rate_hz"), POSITIVE),
     "duration": Range(gt=0, le=3600), "repeats": Range(ge=1, le=100_000), "samples": Range(ge=1, le=1_000_000),
-    "log_dt": Range(ge=1e-4, le=10), "tf_dt": Range(ge=1e-4, le=10),
+    "log_dt": Range(ge=1e-4, le=10), "tf_dt": Range(ge=1e-4, le=10), "workers": Range(ge=0, le=64),
 }
 MAX_CASES = 1000  # runs one experiment may make in one process
 
@@ -188,4 +194,4 @@ def resolve(experiment_id: str) -> Experiment:
     except KeyError:
         raise KeyError(f"pipeline.papers.{module_name(slug)} has no experiment '{name}'") from None
     return Experiment(slug, name, fn, getattr(module, "LIMITS", {}), tuple(getattr(module, "RULES", ())),
-                      getattr(module, "BUDGETS", {}).get(name))
+                      getattr(module, "BUDGETS", {}).get(name), name in getattr(module, "TIMED", ()))

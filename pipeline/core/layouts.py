@@ -13,10 +13,12 @@ from __future__ import annotations
 import importlib
 from collections.abc import Iterable
 from dataclasses import dataclass
-
-import foxglove.layouts as fl
+from typing import TYPE_CHECKING
 
 from pipeline.core import robot
+
+if TYPE_CHECKING:  # the layout model is imported when a run is closed, not when the stage starts
+    import foxglove.layouts as fl
 
 LAYOUT_ATTACHMENT = "foxglove-layout.json"
 MAX_PLOTS = 4
@@ -57,6 +59,8 @@ def key_plots(topics: Iterable[str], slug: str | None = None) -> list[Plot]:
 
 
 def _three_d(topics: set[str]) -> fl.ThreeDeePanel:
+    import foxglove.layouts as fl
+
     layers = {}
     if robot.ROBOT_DESCRIPTION in topics:
         layers["robot"] = fl.BaseRendererUrdfLayerSettings(
@@ -70,6 +74,8 @@ def _three_d(topics: set[str]) -> fl.ThreeDeePanel:
 
 
 def _plot(plot: Plot) -> fl.PlotPanel:
+    import foxglove.layouts as fl
+
     return fl.PlotPanel(title=plot.title, config=fl.PlotConfig(
         paths=[fl.PlotSeries(value=path, label=path.rsplit(".", 1)[-1]) for path in plot.paths], show_legend=True))
 
@@ -77,6 +83,8 @@ def _plot(plot: Plot) -> fl.PlotPanel:
 def foxglove_layout(topics: Iterable[str], slug: str | None = None) -> str:
     """The Foxglove layout (JSON) of a run with these topics: the 3-D scene (URDF driven by the joint
     states, /tf frames, /markers) beside the key plots."""
+    import foxglove.layouts as fl
+
     topics = set(topics)
     plots = [fl.SplitItem(content=_plot(p)) for p in key_plots(topics, slug)]
     scene = fl.SplitItem(proportion=2 if plots else 1, content=_three_d(topics))

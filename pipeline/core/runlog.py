@@ -12,13 +12,12 @@ import functools
 import json
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import foxglove
 import numpy as np
-import pandas as pd
 import yaml
-from foxglove.mcap import MCAPWriteOptions
+from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 from google.protobuf import descriptor_pb2
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
@@ -31,11 +30,15 @@ from pipeline.core import files, layouts, robot, schemas
 from pipeline.core.encoding import encode_series
 from pipeline.robotics.transforms import quaternion_wxyz
 
+if TYPE_CHECKING:  # pandas is for reading runs; a simulate stage does not import it
+    import pandas as pd
+
 RUN_SUFFIX = ".mcap"
 METADATA_NAME = "run"
 CONFIG_ATTACHMENT = "config.yaml"
 MODEL_ATTACHMENT = "model.xml"   # the generated MuJoCo model (MJCF) a run simulates
 CHUNK_BYTES = 1024 * 1024
+COMPRESSION = MCAPCompression.Lz4  # Foxglove, Rerun and the mcap reader all read it; half zstd's cost per message
 # Topics that carry the simulated state: a NaN or an infinity there means the simulation diverged, and the
 # run fails with the first time it happened (every paper gets this watchdog by logging these topics).
 STATE_TOPICS = ("/joint_state", "/tracking_error", "/wrench", "/command")
@@ -102,7 +105,7 @@ class RunWriter:
         self._context = foxglove.Context()
         self._writer = foxglove.open_mcap(
             self._partial, allow_overwrite=True, context=self._context,
-            writer_options=MCAPWriteOptions(chunk_size=CHUNK_BYTES, compression_threads=0))
+            writer_options=MCAPWriteOptions(chunk_size=CHUNK_BYTES, compression_threads=0, compression=COMPRESSION))
         self._open = True
         self._types: dict[str, type[Message] | tuple] = {}  # protobuf class, or robot.ROS2_STRING
         self._pending: dict[str, list[tuple[np.ndarray, list[bytes]]]] = {}
@@ -438,6 +441,8 @@ class _Ros2StringDecoder:
 
 
 def _decode(path: Path, topics: Iterable[str]) -> dict[str, pd.DataFrame]:
+    import pandas as pd
+
     rows: dict[str, list[dict[str, Any]]] = {}
     times: dict[str, list[int]] = {}
     with open(path, "rb") as f:

@@ -4,23 +4,27 @@ from __future__ import annotations
 
 import datetime as dt
 import hashlib
+import multiprocessing
+import os
 import re
+import signal
 import sys
 import time
 import traceback
+from collections.abc import Iterator
 from pathlib import Path
 
 from omegaconf import DictConfig, OmegaConf
 from tqdm import tqdm
 
-from pipeline.core import interrupts, provenance
+from pipeline.core import interrupts, provenance, stages
 from pipeline.core.checks import BadInput, check_cases
 from pipeline.core.experiment import resolve
 from pipeline.core.files import Busy, Locks, stale_partials
 from pipeline.core.runlog import CONFIG_ATTACHMENT, RunWriter, SimulationFailed
 
 # Overrides that do not change what is simulated, so they do not name a run.
-NOT_PARAMS = ("experiment", "data_dir", "progress")
+NOT_PARAMS = ("experiment", "data_dir", "progress", "workers")
 MAX_ID = 120
 
 
@@ -71,31 +75,78 @@ def simulate(cfg: DictConfig, experiment_id: str, overrides: list[str] | None = 
         raise BadInput(f"another process is writing run {busy} under {data_dir}: wait for it, or use another "
                        "data_dir") from None
     errors = 0
+    common = {"slug": slug, "experiment": name, "seed": str(cfg.seed), "params": params,
+              "git_revision": provenance.git_revision(), "package_versions": provenance.package_versions(),
+              "machine": provenance.machine()}
+    workers = 1 if experiment.timed else min(worker_count(cfg.get("workers", 0)), len(cases))
+    common["parallel_runs"] = str(workers)  # a compute time logged beside other runs says so
+    jobs = [(case, rid, out_dir, config_yaml, {**common, "run_id": rid, "case": case.id})
+            for case, rid in zip(cases, ids, strict=True)]
     try:
         for rid in ids:  # left by writers that died: nobody else can hold these names now
             for stale in stale_partials(out_dir / f"{rid}.mcap"):
                 stale.unlink(missing_ok=True)
-        bar = tqdm(list(zip(cases, ids, strict=True)), desc=experiment_id, unit="run",
-                   disable=None if cfg.progress else True, leave=False, file=sys.stderr)
-        for case, rid in bar:
+        bar = tqdm(total=len(jobs), desc=experiment_id, unit="run", disable=None if cfg.progress else True,
+                   leave=False, file=sys.stderr)
+        stages.mark("first_step")
+        results = _in_processes(jobs, workers) if workers > 1 else (_run_case(*job) for job in jobs)
+        for rid, status, bug in results:
+            bar.update()
             bar.set_postfix_str(rid)
-            status, bug = _run_case(case, rid, out_dir, config_yaml, {
-                "slug": slug, "experiment": name, "run_id": rid, "case": case.id, "seed": str(cfg.seed),
-                "params": params, "git_revision": provenance.git_revision(),
-                "package_versions": provenance.package_versions(), "machine": provenance.machine(),
-                "created": dt.datetime.now(dt.UTC).isoformat(timespec="seconds"),
-            })
             errors += bug
             tqdm.write(f"{experiment_id} {rid}: {status}" if status != "ok" else f"wrote {out_dir / rid}.mcap",
                        file=sys.stderr)
+        bar.close()
     finally:
         locks.release()
     return errors
 
 
-def _run_case(case, rid: str, out_dir: Path, config_yaml: str, metadata: dict) -> tuple[str, bool]:
-    """Simulate one case into its run file; (status, whether a bug rather than physics failed it)."""
+def worker_count(requested: int) -> int:
+    """`workers=0` means one process per core this process may use."""
+    if requested:
+        return requested
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
+_JOBS: list[tuple] = []  # the cases of the stage, inherited by forked workers (closures do not pickle)
+
+
+def _run_job(index: int) -> tuple[str, str, bool]:
+    return _run_case(*_JOBS[index])
+
+
+def _start_worker() -> None:
+    # The stage alone takes interrupts: it stops the workers (SIGTERM, which ends them at once) and removes
+    # the runs they left unfinished. A worker whose stage is killed outright ends too.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    interrupts.die_with_parent()
+
+
+def _in_processes(jobs: list[tuple], workers: int) -> Iterator[tuple[str, str, bool]]:
+    """Run the cases in `workers` forked processes, yielding results as they finish.
+
+    Cases are closures over the experiment's config, so the workers are forked after the cases are built and
+    receive an index."""
+    _JOBS[:] = jobs
+    pool = multiprocessing.get_context("fork").Pool(workers, initializer=_start_worker)
+    try:
+        yield from pool.imap_unordered(_run_job, range(len(jobs)))
+        pool.close()
+    finally:
+        pool.terminate()
+        pool.join()
+        _JOBS.clear()
+        for _, rid, out_dir, *_ in jobs:
+            for partial in stale_partials(out_dir / f"{rid}.mcap"):
+                partial.unlink(missing_ok=True)
+
+
+def _run_case(case, rid: str, out_dir: Path, config_yaml: str, metadata: dict) -> tuple[str, str, bool]:
+    """Simulate one case into its run file; (run id, status, whether a bug rather than physics failed it)."""
     bug = False
+    metadata["created"] = dt.datetime.now(dt.UTC).isoformat(timespec="seconds")
     with RunWriter(out_dir / f"{rid}.mcap", metadata) as writer:
         writer.attach(CONFIG_ATTACHMENT, config_yaml, "application/yaml")
         start = time.perf_counter()
@@ -112,4 +163,4 @@ def _run_case(case, rid: str, out_dir: Path, config_yaml: str, metadata: dict) -
         interrupts.raise_if_received()  # swallowed entirely: the run may be cut short, do not publish it
         writer.metadata["wall_time_s"] = f"{time.perf_counter() - start:.3f}"
         writer.close(status)
-    return status, bug
+    return rid, status, bug

@@ -42,6 +42,8 @@ def __getattr__(name: str):
 _BOX = {"tilt": ANGLE, "tilt_x": ANGLE, "twist": ANGLE, "lateral": Range(ge=-0.01, le=0.01),
         "clearance": Range(gt=0, le=0.01)}
 CASES = ("planar", "spatial")
+# Experiments whose compute times are results: their runs have the machine to themselves.
+TIMED = frozenset({"corner-conditions"})
 LIMITS = {
     "scenario.cases": (Length(1, 2), OneOf(CASES)), "scenario.runs": (Length(1, 2), OneOf(("static", "insertion"))),
     "scenario.admittances": (Length(1, 2), OneOf(("designed", "isotropic"))),

@@ -56,6 +56,8 @@ def __getattr__(name: str):
 
 
 _LENGTH = Range(gt=0, le=5.0)   # m
+# Experiments whose compute times are results: their runs have the machine to themselves.
+TIMED = frozenset({"compute-time"})
 LIMITS: dict[str, Range | OneOf] = {
     **{f"system.geometry.{k}": _LENGTH for k in ("d1", "a2", "d2", "d3", "d4", "d5", "d6")},
     "system.method": OneOf(ik.METHODS), "system.tolerances.imag": Range(ge=0, le=1),

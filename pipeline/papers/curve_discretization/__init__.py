@@ -47,6 +47,8 @@ AT_LEAST_TWO = Range(ge=2)
 GAIT_LIMITS = {"amplitude_y": Range(ge=-1, le=1), "amplitude_z": Range(ge=-1, le=1), "wavelength": POSITIVE,
                "frequency": NON_NEGATIVE, "phase_z": ANGLE}
 JOINTS = Range(ge=2, le=1000)  # a snake of 1000 joints is far past any robot the paper considers
+# Experiments whose compute times are results: their runs have the machine to themselves.
+TIMED = frozenset({"timing-fig3", "snake-gait"})
 LIMITS = {
     "system.curve.control_points": Range(ge=-1000, le=1000), "system.twist_hat": OneOf(("corrected", "printed")),
     "system.chain.joints": JOINTS, "system.chain.link_length": POSITIVE, "system.theta_x0": ANGLE,

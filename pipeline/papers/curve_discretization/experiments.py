@@ -12,7 +12,7 @@ from omegaconf import DictConfig
 
 from pipeline.core import schemas
 from pipeline.core.experiment import Case
-from pipeline.core.runlog import RunWriter, SimulationFailed
+from pipeline.core.runlog import MODEL_ATTACHMENT, RunWriter, SimulationFailed
 from pipeline.core.timing import log_timings, time_interleaved
 from pipeline.papers.curve_discretization import algorithm as dc
 from pipeline.papers.curve_discretization import snake as sn
@@ -141,9 +141,11 @@ def timing_fig3(cfg: DictConfig) -> list[Case]:
 
 def gait_curve(spec: DictConfig, length: float):
     """The travelling wave of a gait as a function of time."""
+    a_y, a_z, wavelength, frequency, phase_z = (float(spec[k]) for k in (  # read once, not at every control step
+        "amplitude_y", "amplitude_z", "wavelength", "frequency", "phase_z"))
+
     def at(t: float) -> dc.Curve:
-        return dc.travelling_wave(spec.amplitude_y, spec.amplitude_z, spec.wavelength, 2 * math.pi * spec.frequency * t,
-                                  spec.phase_z, length)
+        return dc.travelling_wave(a_y, a_z, wavelength, 2 * math.pi * frequency * t, phase_z, length)
     return at
 
 
@@ -159,7 +161,7 @@ def snake_gait(cfg: DictConfig) -> list[Case]:
     dt, tol = search_args(cfg)
 
     def simulate(log: RunWriter, gait: str) -> None:
-        log.attach("model.xml", xml, "application/xml")
+        log.attach(MODEL_ATTACHMENT, xml, "application/xml")
         try:
             run = sn.run_gait(chain, body, gait_curve(sc[gait], sc.curve_length), sc.theta_x0, dt, tol, xml,
                               control_dt=ctl.dt, duration=sc.duration, warm_start=ctl.warm_start)

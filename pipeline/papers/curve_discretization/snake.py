@@ -106,7 +106,7 @@ class GaitRun:
     body: np.ndarray            # (K, n+1, 3) the body's joint points in the world
     target: np.ndarray          # (K, n+1, 3) the curve's joint points in the algorithm's frame 1
     seconds: dict[str, np.ndarray]  # (K,) per control step, as the controller ran them: search, angles
-    warm_vs_cold: WarmVsCold        # the searches of steps 1 … K−1 again, warm-started and from scratch
+    warm_vs_cold: WarmVsCold | None  # the searches of steps 1 … K−1 again, warm-started and from scratch
 
 
 @dataclass(frozen=True)
@@ -135,10 +135,12 @@ def warm_vs_cold(chain: Chain, curves: list[Curve], parameters: list[np.ndarray]
 
 
 def run_gait(chain: Chain, body: SnakeBody, curve_at: Callable[[float], Curve], theta_x0: float, dt_search: float,
-             tol: float, xml: str, *, control_dt: float, duration: float, warm_start: bool) -> GaitRun:
+             tol: float, xml: str, *, control_dt: float, duration: float, warm_start: bool,
+             compare_warm_cold: bool = True) -> GaitRun:
     """At every control step solve the curve of that instant (each stage timed), then hold the references for
     the control period. The snake starts at rest in the shape of the curve at t = 0, lying on the floor.
-    The algorithm is warmed up on that curve first (numba loads its compiled code at the first call)."""
+    The algorithm is warmed up on that curve first (numba loads its compiled code at the first call).
+    Afterwards (`compare_warm_cold`) the searches are timed again warm-started and from scratch."""
     import mujoco
 
     from pipeline.robotics.mjcf import check_mujoco
@@ -194,7 +196,7 @@ def run_gait(chain: Chain, body: SnakeBody, curve_at: Callable[[float], Curve], 
     times = np.arange(steps) * control_dt
     check_mujoco(data, qpos, times)
     return GaitRun(times, q_ref, qd_ref, q, qd, tau, qpos, body_pts, target, seconds,
-                   warm_vs_cold(chain, curves, parameters, dt_search, tol))
+                   warm_vs_cold(chain, curves, parameters, dt_search, tol) if compare_warm_cold else None)
 
 
 def shape_fit(body: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

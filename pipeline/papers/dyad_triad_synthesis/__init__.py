@@ -38,6 +38,8 @@ def _count(upper: int) -> Range:
     return Range(ge=1, le=upper)
 
 
+# Experiments whose compute times are results: their runs have the machine to themselves.
+TIMED = frozenset({"compute-time"})
 LIMITS = {
     "system.length_unit": Range(gt=0, le=1000), "system.table4.points": Range(ge=-1e6, le=1e6),
     "system.table4.alpha_deg": Range(ge=-360, le=360),

@@ -44,6 +44,8 @@ def __getattr__(name: str):
     raise AttributeError(name)
 
 
+# Experiments whose compute times are results: their runs have the machine to themselves.
+TIMED = frozenset({"compute-time", "tracking", "fixed-obstacles", "moving-obstacles"})
 LIMITS = {
     "system.dt": Range(ge=1e-3, le=0.1), "system.planning.sample_dt": Range(ge=1e-3, le=0.1),
     "system.plant.physics_dt": Range(ge=1e-5, le=0.01), "system.scene.obstacles.names": Text(),

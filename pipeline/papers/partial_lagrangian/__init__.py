@@ -56,6 +56,8 @@ def __getattr__(name: str):
 
 LINKS = Range(ge=1, le=10)   # the configured parameter lists hold 10 links (Sect. 4: up to 10 DoF)
 DURATION = Range(gt=0, le=600)
+# Experiments whose compute times are results: their runs have the machine to themselves.
+TIMED = frozenset({"compute-time"})
 LIMITS = {
     "system.damping_model": OneOf(DAMPING_MODELS), "system.simulation.formulation": OneOf(FORMS),
     "system.simulation.integrator": OneOf(INTEGRATORS), "scenario.joints": OneOf((REVOLUTE, PRISMATIC)),

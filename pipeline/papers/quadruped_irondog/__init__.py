@@ -39,6 +39,8 @@ ANGLE_DEG = Range(ge=-180, le=180)
 SECONDS = Range(ge=0, le=60)
 TRUNK_PARTS = ("base", "head", "back_shell", "pitch_mounts", "coxa_servos", "battery", "other", "screws")
 
+# Experiments whose compute times are results: their runs have the machine to themselves.
+TIMED = frozenset({"kinematics"})
 LIMITS = {
     **{f"system.leg.{k}": LENGTH for k in ("L1", "L2", "L3")},
     "system.leg.ik_form": OneOf(("corrected", "printed")),

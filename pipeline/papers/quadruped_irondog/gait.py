@@ -8,10 +8,10 @@ first (Sec. 3.3).
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import comb
 
 from pipeline.papers.quadruped_irondog.kinematics import LEGS
 
@@ -26,7 +26,7 @@ def bernstein(s, degree: int) -> np.ndarray:
 
 @functools.cache
 def _binomials(degree: int) -> np.ndarray:
-    return comb(degree, np.arange(degree + 1))
+    return np.array([math.comb(degree, k) for k in range(degree + 1)], dtype=float)
 
 
 def bezier(points, s) -> np.ndarray:

@@ -46,6 +46,8 @@ def __getattr__(name: str):
 RADIUS = Range(gt=0, le=1.0)   # m: spheres of a desk-size robot
 FORMS = OneOf(("corrected", "printed"))
 STEP = Range(ge=1e-4, le=0.1)
+# Experiments whose compute times are results: their runs have the machine to themselves.
+TIMED = frozenset({"reach-poses", "avoid-obstacles"})
 LIMITS = {
     "system.model.radius_convention": FORMS, "system.model.free_mode_sign": FORMS,
     "system.model.joint_update": OneOf(("incremental", "global")), "system.trolley.azimuth": FORMS,

@@ -36,6 +36,8 @@ LENGTH = Range(gt=0, le=5.0)        # m
 POSITION = Range(ge=-5.0, le=5.0)   # m
 SIGN = OneOf((1, -1))
 TURNS = Range(ge=0, le=1000)        # cycles over a run
+# Experiments whose compute times are results: their runs have the machine to themselves.
+TIMED = frozenset({"compute-time", "circle"})
 LIMITS = {
     "system.geometry.a0": LENGTH, "system.geometry.a1": LENGTH, "system.geometry.a2": LENGTH,
     "system.geometry.a3": LENGTH, "system.geometry.tool_rotation_y": ANGLE,

@@ -58,6 +58,8 @@ def __getattr__(name: str):
 
 STEP = Range(ge=1e-5, le=0.1)   # s: time steps and log periods
 PATHS = ("wrist", "shoulder", "elbow")
+# Experiments whose compute times are results: their runs have the machine to themselves.
+TIMED = frozenset({"compute-time"})
 LIMITS = {
     "system.fk_form": OneOf(("corrected", "printed")),
     "system.conventions.sqrt_negative": OneOf(("abs", "clamp", "reject")),

@@ -8,7 +8,6 @@ from math import pi
 
 import numpy as np
 from omegaconf import DictConfig, OmegaConf
-from scipy.optimize import brentq
 
 from pipeline.core import schemas
 from pipeline.core.experiment import Case
@@ -122,6 +121,8 @@ def flange_path(kind: str, spec: DictConfig, g: Geometry, times: np.ndarray, dur
         qs[:, 1] = grid
         f = shoulder_term(qs, g)
         i = int(np.flatnonzero(np.sign(f[:-1]) != np.sign(f[1:]))[0])
+        from scipy.optimize import brentq  # only this path needs SciPy's optimizers (slow to import)
+
         q_mid[1] = brentq(lambda x: float(shoulder_term(np.r_[q_mid[0], x, q_mid[2:]], g)), grid[i], grid[i + 1],
                           xtol=1e-15)
     F = dhk.frames(dhk.DH.from_config(g.dh), q_mid)
