@@ -37,6 +37,8 @@ _ARM = {"joints": Range(ge=1, le=6), "dh.a": Range(ge=-5, le=5), "dh.d": Range(g
         "masses": Range(gt=0, le=1000), "armature": Range(ge=0, le=100), "damping": Range(ge=0, le=1000),
         "torque_limit": Range(gt=0, le=1e4)}
 
+# Experiments whose compute times are results: their runs have the machine to themselves.
+TIMED = frozenset({"table1", "search"})
 LIMITS: dict[str, Limit | tuple[Limit, ...]] = {
     **{f"system.{arm}.{key}": r for arm in ("planar", "puma") for key, r in _ARM.items()},
     # sizes: the grid's node count is bounded when the experiment makes its cases (graph.check_size)
