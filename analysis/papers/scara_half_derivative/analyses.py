@@ -8,7 +8,15 @@ import pandas as pd
 from analysis.core.compute_time import timing_metrics
 from analysis.core.figures import Figures
 from analysis.core.metrics import MetricTable
-from analysis.papers.scara_half_derivative.figures import _error_figures, _map_figure, _path_figure, _setpoint_figures
+from analysis.papers.scara_half_derivative.figures import (
+    _error_figures,
+    _map_figure,
+    _maps_bands_figure,
+    _path_figure,
+    _setpoint_figures,
+    _stiffness_figure,
+    _table2_bands_figure,
+)
 from analysis.papers.scara_half_derivative.metrics import (
     AXES,
     KD_DAMPING,
@@ -20,7 +28,9 @@ from analysis.papers.scara_half_derivative.metrics import (
     _ringing,
     _stiffness_id,
     _tuning,
+    aggregate_id,
     equal_ice_locus,
+    ice_argmin,
     grid_frame,
     tuning_metrics,
 )
@@ -55,21 +65,16 @@ def analyze_setpoint(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-def analyze_table2(runs: list[Run], figures: Figures) -> pd.DataFrame:
-    m = MetricTable()
-    by_stiffness: dict[float, dict[str, tuple[Run, dict]]] = {}
-    timings: dict[str, list[np.ndarray]] = {}
+def _table2_metrics(runs: list[Run], m: MetricTable) -> dict[str, dict[str, tuple[Run, dict]]]:
+    """Table 2's indexes of every run, the percentages vs KD and the oscillation claim per stiffness and sweep
+    point (aggregate id k80000, or k80000__<sweep point>); returns the runs by that id and controller."""
+    groups: dict[str, dict[str, tuple[Run, dict]]] = {}
     for run in runs:
         name = run.metadata["case"].rsplit("-k", 1)[0]
         values = tuning_metrics(run) | {"ringing": (_ringing(run), "count")}
         m.add_run(run, values)
-        by_stiffness.setdefault(_tuning(run)["k_xyz"], {})[name] = (run, values)
-        law = _model(run)["law"]
-        timings.setdefault(law, []).append(run["/compute_time"][f"seconds.{law}"].dropna().to_numpy())
-    for law, samples in timings.items():   # every control step of every run of the law
-        for metric, (value, unit) in timing_metrics(f"controller.{law}", np.concatenate(samples)).items():
-            m.add("all", metric, value, unit)
-    for k, controllers in by_stiffness.items():
+        groups.setdefault(aggregate_id(_stiffness_id(_tuning(run)["k_xyz"]), run), {})[name] = (run, values)
+    for group, controllers in groups.items():
         if "kd" in controllers:
             reference = controllers["kd"][1]
             for name, (run, values) in controllers.items():
@@ -78,31 +83,80 @@ def analyze_table2(runs: list[Run], figures: Figures) -> pd.DataFrame:
         ringing = {name: v["ringing"][0] for name, (_, v) in controllers.items()}
         if {"kd", "kdhd", "khd"} <= set(ringing):
             more = ringing["khd"] > max(ringing["kd"], ringing["kdhd"])
-            m.add(_stiffness_id(k), "claim.khd_more_oscillatory", float(more), "bool")
-        _error_figures(k, controllers, figures)
+            m.add(group, "claim.khd_more_oscillatory", float(more), "bool")
+    return groups
+
+
+def analyze_table2(runs: list[Run], figures: Figures) -> pd.DataFrame:
+    m = MetricTable()
+    groups = _table2_metrics(runs, m)
+    timings: dict[str, list[np.ndarray]] = {}
+    for run in runs:
+        law = _model(run)["law"]
+        if "/compute_time" in run.topic_names:
+            timings.setdefault(law, []).append(run["/compute_time"][f"seconds.{law}"].dropna().to_numpy())
+    for law, samples in timings.items():   # every control step of every run of the law
+        for metric, (value, unit) in timing_metrics(f"controller.{law}", np.concatenate(samples)).items():
+            m.add("all", metric, value, unit)
+    for group, controllers in groups.items():
+        if "__" not in group:   # the figures show the default runs
+            _error_figures(_tuning(next(iter(controllers.values()))[0])["k_xyz"], controllers, figures)
     return m.frame()
+
+
+def analyze_table2_sensitivity(runs: list[Run], figures: Figures) -> pd.DataFrame:
+    m = MetricTable()
+    _table2_metrics(runs, m)
+    frame = m.frame()
+    _table2_bands_figure(frame, figures)
+    return frame
+
+
+def analyze_stiffness(runs: list[Run], figures: Figures) -> pd.DataFrame:
+    m = MetricTable()
+    _table2_metrics(runs, m)
+    frame = m.frame()
+    _stiffness_figure(frame, figures)
+    return frame
+
+
+def _maps_metrics(grid: pd.DataFrame, m: MetricTable) -> None:
+    """ICE and ISE of every grid point; per stiffness and sweep point: KD's ICE, the equal-ICE line through it
+    (eq. 20), where ICE is least along KD's row, and the claims of Sec. 5."""
+    for row in grid.to_dict("records"):
+        params = {key: row[key] for key in ("k_xyz", "d_xyz", "hd_xyz")}
+        m.add(row["run_id"], "ise", row["ise"], "m^2*s", params)
+        m.add(row["run_id"], "ice", row["ice"], "N^2*m^2*s", params)
+    for group, part in grid.groupby("group"):
+        k = float(part["k_xyz"].iloc[0])
+        level, points = equal_ice_locus(part)
+        m.add(group, "ice.kd", level, "N^2*m^2*s", {"k_xyz": k})
+        m.add(group, "ice.argmin_d", ice_argmin(part), "Ns/m", {"k_xyz": k})
+        m.add(group, "locus.points", len(points), "count", {"k_xyz": k})
+        if len(points) >= 2:
+            d, hd = np.array(points).T
+            slope, intercept = np.polyfit(d, hd, 1)
+            m.add(group, "locus.slope", slope, "s^-0.5", {"k_xyz": k})
+            m.add(group, "locus.intercept", intercept, "Ns^0.5/m", {"k_xyz": k})
+        m.add(group, "claim.ice_increases", float(_monotonic(part, "ice", +1)), "bool", {"k_xyz": k})
+        m.add(group, "claim.ise_decreases", float(_monotonic(part, "ise", -1)), "bool", {"k_xyz": k})
 
 
 def analyze_maps(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     grid = grid_frame(runs)
-    for row in grid.to_dict("records"):
-        params = {key: row[key] for key in ("k_xyz", "d_xyz", "hd_xyz")}
-        m.add(row["run_id"], "ise", row["ise"], "m^2*s", params)
-        m.add(row["run_id"], "ice", row["ice"], "N^2*m^2*s", params)
-    for k, part in grid.groupby("k_xyz"):
-        sid = _stiffness_id(k)
-        level, points = equal_ice_locus(part)
-        m.add(sid, "ice.kd", level, "N^2*m^2*s", {"k_xyz": k})
-        m.add(sid, "locus.points", len(points), "count", {"k_xyz": k})
-        if len(points) >= 2:
-            d, hd = np.array(points).T
-            slope, intercept = np.polyfit(d, hd, 1)
-            m.add(sid, "locus.slope", slope, "s^-0.5", {"k_xyz": k})
-            m.add(sid, "locus.intercept", intercept, "Ns^0.5/m", {"k_xyz": k})
-        m.add(sid, "claim.ice_increases", float(_monotonic(part, "ice", +1)), "bool", {"k_xyz": k})
-        m.add(sid, "claim.ise_decreases", float(_monotonic(part, "ise", -1)), "bool", {"k_xyz": k})
-        _map_figure(k, part, level, points, figures)
+    _maps_metrics(grid, m)
+    for group, part in grid.groupby("group"):
+        if "__" not in group:
+            _map_figure(float(part["k_xyz"].iloc[0]), part, *equal_ice_locus(part), figures)
+    return m.frame()
+
+
+def analyze_maps_sensitivity(runs: list[Run], figures: Figures) -> pd.DataFrame:
+    m = MetricTable()
+    grid = grid_frame(runs)
+    _maps_metrics(grid, m)
+    _maps_bands_figure(grid, figures)
     return m.frame()
 
 
@@ -132,4 +186,6 @@ def analyze_locus(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-ANALYSES = {"setpoint": analyze_setpoint, "table2": analyze_table2, "maps": analyze_maps, "locus": analyze_locus}
+ANALYSES = {"setpoint": analyze_setpoint, "table2": analyze_table2, "maps": analyze_maps, "locus": analyze_locus,
+            "table2-sensitivity": analyze_table2_sensitivity, "maps-sensitivity": analyze_maps_sensitivity,
+            "stiffness": analyze_stiffness}

@@ -10,6 +10,7 @@ from analysis.core.errors import error_stats
 from analysis.core.metrics import MetricTable
 from analysis.core.targets import paper_value
 from pipeline.core.runlog import Run
+from pipeline.core.runner import run_id
 
 AXES = ("x", "y", "z")
 
@@ -53,6 +54,22 @@ def _tuning(run: Run) -> dict[str, float]:
 
 def _stiffness_id(k: float) -> str:
     return f"k{k:g}"
+
+
+GRID_KEYS = ("scenario.k_xyz", "scenario.d_xyz", "scenario.hd_xyz")   # what a case id already says
+
+
+def variant(run: Run) -> dict[str, str]:
+    """The run's swept parameters other than the tuning its case id names: which point of a sensitivity
+    sweep (system.control.implementation, system.inertia_scale, scenario.duration) it belongs to."""
+    return {k: v for k, v in run.params.items() if k not in GRID_KEYS}
+
+
+def aggregate_id(name: str, run: Run) -> str:
+    """`name` (e.g. k80000) suffixed like the run ids of the sweep point `run` belongs to
+    (k80000__system.control.implementation=continuous,…): the aggregates of a sweep point are found, like its
+    runs, under `<name>__…`."""
+    return run_id(name, variant(run))
 
 
 def tuning_metrics(run: Run) -> dict[str, tuple[float, str]]:
@@ -113,35 +130,40 @@ def _ringing(run: Run) -> int:
 
 
 def grid_frame(runs: list[Run]) -> pd.DataFrame:
-    """One row per grid point on disk (k_xyz, d_xyz, hd_xyz, run_id, ISE, ICE, peak torques); a point run
-    twice (the sweep and the default run) is kept once."""
-    rows = [{**_tuning(run), "run_id": run.run_id, **{k: v for k, (v, _) in tuning_metrics(run).items()}}
-            for run in runs]
+    """One row per grid point on disk (k_xyz, d_xyz, hd_xyz, run_id, ISE, ICE, peak torques) and the id of
+    its stiffness's aggregates (`group`: k80000, or k80000__<sweep point>); a point run twice in one group
+    (a sweep and the default run) is kept once."""
+    rows = [{**_tuning(run), "run_id": run.run_id, "group": aggregate_id(_stiffness_id(_tuning(run)["k_xyz"]), run),
+             **variant(run), **{k: v for k, (v, _) in tuning_metrics(run).items()}} for run in runs]
     if not rows:
-        return pd.DataFrame(columns=["k_xyz", "d_xyz", "hd_xyz", "run_id", "ise", "ice"])
-    frame = pd.DataFrame(rows).sort_values(["k_xyz", "d_xyz", "hd_xyz", "run_id"])
-    return frame.drop_duplicates(["k_xyz", "d_xyz", "hd_xyz"]).reset_index(drop=True)
+        return pd.DataFrame(columns=["k_xyz", "d_xyz", "hd_xyz", "run_id", "group", "ise", "ice"])
+    frame = pd.DataFrame(rows).sort_values(["group", "d_xyz", "hd_xyz", "run_id"])
+    return frame.drop_duplicates(["group", "d_xyz", "hd_xyz"]).reset_index(drop=True)
 
 
 def equal_ice_locus(grid: pd.DataFrame) -> tuple[float, list[tuple[float, float]]]:
-    """(ICE of KD at d = 5000, points (d, hd) where ICE equals it): for each hd of the grid, the d at which
-    ICE crosses the level, by linear interpolation along d (the KD point itself included)."""
+    """(ICE of KD at d = 5000, the points (d, hd) of the equal-ICE line through KD): from KD upward in hd, on
+    each row of the grid the d at which ICE crosses KD's level (linear interpolation along d) nearest to the
+    previous point's, until a row has no crossing (the level set through KD has left the grid or closed)."""
     kd = grid[(grid["hd_xyz"] == 0) & np.isclose(grid["d_xyz"], KD_DAMPING, rtol=LEVEL_TOLERANCE)]
     if kd.empty:
         return float("nan"), []
     level = float(kd["ice"].iloc[0])
-    points = []
-    for hd, column in grid.groupby("hd_xyz"):
-        column = column.sort_values("d_xyz")
-        d, ice = column["d_xyz"].to_numpy(), column["ice"].to_numpy() - level
-        for i in range(len(d) - 1):
-            if ice[i] == 0:
-                points.append((float(d[i]), float(hd)))
-            elif ice[i] * ice[i + 1] < 0:
-                points.append((float(d[i] - ice[i] * (d[i + 1] - d[i]) / (ice[i + 1] - ice[i])), float(hd)))
-        if len(d) and ice[-1] == 0:
-            points.append((float(d[-1]), float(hd)))
-    return level, sorted(set(points))
+    points = [(KD_DAMPING, 0.0)]
+    for hd, row in grid[grid["hd_xyz"] > 0].groupby("hd_xyz"):
+        row = row.sort_values("d_xyz")
+        d, ice = row["d_xyz"].to_numpy(), row["ice"].to_numpy() - level
+        crossings = [float(d[i]) for i in range(len(d)) if ice[i] == 0]
+        crossings += [float(d[i] - ice[i] * (d[i + 1] - d[i]) / (ice[i + 1] - ice[i]))
+                      for i in range(len(d) - 1) if ice[i] * ice[i + 1] < 0]
+        if not crossings:
+            break
+        points.append((min(crossings, key=lambda c: abs(c - points[-1][0])), float(hd)))
+    return level, points
+def ice_argmin(grid: pd.DataFrame) -> float:
+    """The d_xyz of least ICE along KD's row (hd_xyz = 0): where "more damping, more effort" stops or starts."""
+    row = grid[grid["hd_xyz"] == 0]
+    return float(row.loc[row["ice"].idxmin(), "d_xyz"]) if len(row) else float("nan")
 
 
 def _monotonic(grid: pd.DataFrame, metric: str, sign: int) -> bool:
