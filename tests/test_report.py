@@ -132,6 +132,34 @@ def test_not_run_and_failed_runs():
     assert aggregate["status"] == "miss" and "r2 failed: unstable" in aggregate["note"]
 
 
+def _interval_metrics(median: float, low: float, high: float) -> dict[str, pd.DataFrame]:
+    return {"exp": pd.DataFrame([{"run_id": "r1", "metric": m, "value": v, "unit": "m"} for m, v in
+                                 (("m", median), ("m.ci_low", low), ("m.ci_high", high))])}
+
+
+@pytest.mark.parametrize(("low", "high", "status"), [
+    (0.8, 1.3, "match"),          # the paper's 1.0 inside our interval, although the median is 1.2 (> 1.1 away)
+    (1.0, 1.3, "match"),          # on the bound
+    (1.05, 1.3, "miss"),          # excluded, however near: an interval has no `close`
+    (0.5, 0.99, "miss"),
+    (float("nan"), float("nan"), "miss"),   # no interval written: nothing supports a match
+])
+def test_interval_rule(low, high, status):
+    """tolerance `ci`: the paper's value against the interval the analysis writes beside the metric."""
+    row = evaluate("p", _targets(tolerance="ci"), _interval_metrics(1.2, low, high), _runs(("r1", "ok"))).iloc[0]
+    assert row["status"] == status and row["pipeline_value"] == pytest.approx(1.2)
+    assert row["tolerance"] == "95% CI" and "95 % interval" in row["note"]
+    if status == "miss":
+        assert row["cause"] == "open"
+
+
+def test_interval_rule_judges_equality_only(tmp_path):
+    path = tmp_path / "targets.csv"
+    _targets(tolerance="ci", op="<=").to_csv(path, index=False)
+    with pytest.raises(ValueError, match="tolerance `ci` judges `==`"):
+        load_targets(path)
+
+
 def test_consistency_rows_are_never_reproductions():
     agree = evaluate("p", _targets(mode="consistency", basis="paper"), _metrics(1.0), _runs(("r1", "ok"))).iloc[0]
     assert agree["status"] == "agrees"

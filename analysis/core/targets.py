@@ -13,7 +13,10 @@ Each paper has `analysis/papers/<module>/targets.csv` with one row per reported 
   paper against itself (its printed numbers against each other): never a reproduction.
 - `op`: how `value` is compared: `==` (within tolerance), or `<`, `<=`, `>`, `>=` (a bound or ranking)
 - `tolerance`: `<x>` absolute, `<x> rel` relative, `<x> wrap` absolute on angles modulo 2π (±π equal);
-  for an inequality, the margin by which it may fail and still count as close
+  for an inequality, the margin by which it may fail and still count as close; `ci` (with `==`): the analysis
+  writes an interval beside the metric, `<metric>.ci_low` and `<metric>.ci_high` (e.g. a bootstrap 95 %
+  confidence interval), and the target is a match when the paper's value lies inside it, a miss when the
+  interval excludes it (no close); the pipeline value is the metric itself (e.g. the bootstrap median)
 - `basis`: what the pipeline value is computed from: `simulation` (a simulated system), `algorithm` (the
   paper's algorithm run on its inputs: IK, synthesis, planning, …) or `paper` (arithmetic on the paper's
   own printed numbers). A `paper` basis goes with mode `consistency`, and only with it.
@@ -106,20 +109,29 @@ COLUMNS = ["target_id", "category", "quantity", "where", "value", "unit", "mode"
            "cause", "experiment", "run", "metric", "band", "note"]
 
 
+INTERVAL = "ci"                           # the tolerance of a target judged by the interval the analysis writes
+INTERVAL_BOUNDS = (".ci_low", ".ci_high")  # suffixes of that interval's metrics
+
+
 @dataclass(frozen=True)
 class Tolerance:
     value: float = 0.0
     relative: bool = False
     wrap: bool = False
+    interval: bool = False
 
     @classmethod
     def parse(cls, text: str) -> Tolerance:
         parts = str(text).split() if isinstance(text, str) and text.strip() else []
         if not parts:
             return cls()
+        if parts == [INTERVAL]:
+            return cls(interval=True)
         return cls(float(parts[0]), relative="rel" in parts[1:], wrap="wrap" in parts[1:])
 
     def __str__(self) -> str:
+        if self.interval:
+            return "95% CI"
         if not self.value:
             return ""
         return f"{self.value:g}" + (" rel" if self.relative else "") + (" (mod 2π)" if self.wrap else "")
@@ -145,6 +157,10 @@ def load_targets(path: Path) -> pd.DataFrame:
     if not banded.empty:
         raise ValueError(f"{path}: {banded['target_id'].tolist()}: a band belongs to a reproduction target "
                          "(not to a consistency or not-reproducible row)")
+    odd_interval = targets[(targets["tolerance"] == INTERVAL) & (targets["op"] != "==")]
+    if not odd_interval.empty:
+        raise ValueError(f"{path}: {odd_interval['target_id'].tolist()}: the tolerance `{INTERVAL}` judges `==` "
+                         "(the paper's value inside the interval)")
     dupes = targets["target_id"][targets["target_id"].duplicated()].tolist()
     if dupes:
         raise ValueError(f"{path}: duplicate target ids {dupes}")
@@ -172,6 +188,11 @@ def deviation(pipeline: float, paper: float, tol: Tolerance) -> float:
     """pipeline − paper (modulo 2π for angles that wrap)."""
     d = pipeline - paper
     return math.remainder(d, 2 * math.pi) if tol.wrap else d
+
+
+def judge_interval(low: float, high: float, paper: float) -> str:
+    """match when the paper's value lies in the pipeline's interval [low, high], else miss (no interval: miss)."""
+    return "match" if low <= paper <= high else "miss"   # NaN bounds fail both comparisons
 
 
 def judge(pipeline: float, paper: float, op: str, tol: Tolerance) -> str:
@@ -235,6 +256,12 @@ def self_check(evaluated: pd.DataFrame) -> list[str]:
             f"declare {' or '.join(BAND_CAUSES)} with the reason" for r in bad.itertuples()]
 
 
+def _metric_of(of_run: pd.DataFrame, metric: str, unit: str) -> float:
+    """One metric of one run's rows, in `unit`; NaN if absent."""
+    hit = of_run[of_run["metric"] == metric]
+    return convert(float(hit["value"].iloc[0]), hit["unit"].iloc[0], unit) if not hit.empty else float("nan")
+
+
 def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
              runs: pd.DataFrame | None = None) -> pd.DataFrame:
     """One row per target with the pipeline's value (in the paper's unit), its deviation and a status.
@@ -285,6 +312,10 @@ def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
                 row["deviation"] = deviation(value, paper, tol)
                 row["relative_deviation"] = row["deviation"] / abs(paper) if paper else float("nan")
                 row["status"] = judge(value, paper, t.op, tol)
+                if tol.interval:
+                    low, high = (_metric_of(of_run, t.metric + suffix, t.unit) for suffix in INTERVAL_BOUNDS)
+                    row["status"] = judge_interval(low, high, paper)
+                    row["note"] = "; ".join(x for x in (t.note, f"our 95 % interval [{low:.4g}, {high:.4g}]") if x)
             if row["band"]:
                 low, high = band(metrics.get(row["band"]), ok_runs.get(row["band"], set()), t.run, t.metric,
                                  t.unit)
