@@ -31,6 +31,9 @@ CONTROL_HORIZON = 0.04             # s: 4 × 10 ms; solves longer than this dela
 TARGETS = Path(__file__).with_name("targets.csv")
 
 
+SLUG = "nmpc-cdkd"
+
+
 CASE_LABELS = {"no-obstacle": "without obstacles", "obstacle": "with obstacle",
                "obstacle-height": "with obstacle and height constraints"}
 
@@ -50,6 +53,9 @@ def _xyz(frame: pd.DataFrame, field: str) -> np.ndarray:
 
 
 def _solve_metrics(solves: pd.DataFrame) -> dict[str, tuple[float, str]]:
+    """Statistics of the timed solves (a probe's warm-up solve is not timed)."""
+    if "timed" in solves:
+        solves = solves[solves["timed"].astype(bool)]
     s = solves["seconds"].to_numpy()
     values = {"solve.mean": (s.mean(), "s"), "solve.std": (s.std(), "s"), **timing_metrics("solve", s),
               "solve.samples": (len(s), "count"), "solve.iterations_mean": (solves["iterations"].mean(), "count"),
@@ -58,12 +64,6 @@ def _solve_metrics(solves: pd.DataFrame) -> dict[str, tuple[float, str]]:
               "solve.over_control_horizon": ((s > CONTROL_HORIZON).mean(), "fraction"),
               "solve.casadi_mean": (solves["solver_seconds"].mean(), "s")}
     return values
-
-
-def _combo(run_id: str) -> tuple[str, str, int]:
-    model, rest = run_id.split("__")[0].split("-", 1)
-    case, k = rest.rsplit("-k", 1)
-    return model, case, int(k)
 
 
 def _arrival(run: Run) -> float:
