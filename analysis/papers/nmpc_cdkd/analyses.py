@@ -20,6 +20,8 @@ from analysis.papers.nmpc_cdkd.metrics import (
     _obstacle_metrics,
     _solve_metrics,
     _trajectory_metrics,
+    case_config,
+    orientation_lag_model,
 )
 from analysis.papers.nmpc_cdkd.table3 import per_seed, table3, timed_solves
 from pipeline.core.runlog import Run
@@ -59,8 +61,9 @@ def analyze_tracking(runs: list[Run], figures: Figures) -> pd.DataFrame:
         values["claim.no_stationary_error"] = (float(values["tool_error.final"][0] < ARRIVAL_POSITION), "bool")
         values["claim.lag_from_orientation"] = (
             float(values["wrist_error.max"][0] < 0.1 * values["tool_error.max"][0]), "bool")
+        values |= orientation_lag_model(run)
         m.add_run(run, values)
-        tool_error[run.metadata["case"]] = (run.config["system"]["dh"]["tool_d"], values["tool_error.max"][0])
+        tool_error[run.metadata["case"]] = (case_config(run)["system"]["dh"]["tool_d"], values["tool_error.max"][0])
         _fig3(run, figures)
     for model in ("decomposed", "full"):  # Sec. 4.2: a shorter d_e gives smaller amplitudes in Fig. 3b
         pairs = sorted(v for case, v in tool_error.items() if case.split("-de")[0] == model)

@@ -30,8 +30,10 @@ from analysis.papers.scara_half_derivative.metrics import (
     _tuning,
     aggregate_id,
     equal_ice_locus,
-    ice_argmin,
     grid_frame,
+    ice_argmin,
+    rising_fraction,
+    stiffness_bound,
     tuning_metrics,
 )
 from pipeline.core.runlog import Run
@@ -60,6 +62,7 @@ def analyze_setpoint(runs: list[Run], figures: Figures) -> pd.DataFrame:
         }
         values |= {f"home.{c}": (float(ref[f"position.{c}"].iloc[0]), "m" if c != "theta" else "rad")
                    for c in (*AXES, "theta")}
+        values["table2.stiffness_bound"] = (stiffness_bound(arm, q), "N/m")
         m.add_run(run, values)
         _setpoint_figures(ref, joints, figures)
     return m.frame()
@@ -99,8 +102,7 @@ def analyze_table2(runs: list[Run], figures: Figures) -> pd.DataFrame:
         for metric, (value, unit) in timing_metrics(f"controller.{law}", np.concatenate(samples)).items():
             m.add("all", metric, value, unit)
     for group, controllers in groups.items():
-        if "__" not in group:   # the figures show the default runs
-            _error_figures(_tuning(next(iter(controllers.values()))[0])["k_xyz"], controllers, figures)
+        _error_figures(_tuning(next(iter(controllers.values()))[0])["k_xyz"], controllers, figures, group)
     return m.frame()
 
 
@@ -132,6 +134,7 @@ def _maps_metrics(grid: pd.DataFrame, m: MetricTable) -> None:
         level, points = equal_ice_locus(part)
         m.add(group, "ice.kd", level, "N^2*m^2*s", {"k_xyz": k})
         m.add(group, "ice.argmin_d", ice_argmin(part), "Ns/m", {"k_xyz": k})
+        m.add(group, "ice.rising_fraction", rising_fraction(part, "ice"), "fraction", {"k_xyz": k})
         m.add(group, "locus.points", len(points), "count", {"k_xyz": k})
         if len(points) >= 2:
             d, hd = np.array(points).T
@@ -147,8 +150,7 @@ def analyze_maps(runs: list[Run], figures: Figures) -> pd.DataFrame:
     grid = grid_frame(runs)
     _maps_metrics(grid, m)
     for group, part in grid.groupby("group"):
-        if "__" not in group:
-            _map_figure(float(part["k_xyz"].iloc[0]), part, *equal_ice_locus(part), figures)
+        _map_figure(float(part["k_xyz"].iloc[0]), part, *equal_ice_locus(part), figures, group)
     return m.frame()
 
 

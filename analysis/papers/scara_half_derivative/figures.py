@@ -45,7 +45,7 @@ def _setpoint_figures(ref: pd.DataFrame, joints: pd.DataFrame, figures: Figures)
     figures.save(fig, "fig5-joints")
 
 
-def _error_figures(k: float, controllers: dict[str, tuple[Run, dict]], figures: Figures) -> None:
+def _error_figures(k: float, controllers: dict[str, tuple[Run, dict]], figures: Figures, name: str) -> None:
     """Figs. 8-10: e_x, e_y, e_z of the three controllers, the whole run and a zoom on the largest peak."""
     for fig_number, axis in zip((8, 9, 10), AXES, strict=True):
         fig, (full, zoom) = plt.subplots(1, 2, figsize=(10, 3.4), gridspec_kw={"width_ratios": [2.2, 1]})
@@ -70,10 +70,10 @@ def _error_figures(k: float, controllers: dict[str, tuple[Run, dict]], figures: 
         full.set_ylabel(f"e_{axis} [mm]")
         full.legend(ncol=3, loc="center", bbox_to_anchor=(0.5, 0.75))   # between the traces and the paper lines
         fig.suptitle(f"Fig. {fig_number}: error e_{axis}, K = {k:g} N/m")
-        figures.save(fig, f"fig{fig_number}-e{axis}-{_stiffness_id(k)}")
+        figures.save(fig, f"fig{fig_number}-e{axis}-{name}")
 
 
-def _map_figure(k: float, grid: pd.DataFrame, level: float, points: list, figures: Figures) -> None:
+def _map_figure(k: float, grid: pd.DataFrame, level: float, points: list, figures: Figures, name: str) -> None:
     """Fig. 6 as surfaces (red, with the KD level as a green plane) and as contour maps with the equal-ICE
     points, our fitted line and eq. (20)."""
     ice = grid.pivot(index="hd_xyz", columns="d_xyz", values="ice")
@@ -87,7 +87,7 @@ def _map_figure(k: float, grid: pd.DataFrame, level: float, points: list, figure
             ax.set_ylabel(label)
         axes[0].legend()
         fig.suptitle(f"Fig. 6 (one grid line on disk), K = {k:g} N/m")
-        figures.save(fig, f"fig6-maps-{_stiffness_id(k)}")
+        figures.save(fig, f"fig6-maps-{name}")
         return
     D, HD = np.meshgrid(ice.columns.to_numpy(), ice.index.to_numpy())
     fig = plt.figure(figsize=(11, 8))
@@ -122,7 +122,7 @@ def _map_figure(k: float, grid: pd.DataFrame, level: float, points: list, figure
         flat.legend(loc="upper right", fontsize=7)
     fig.suptitle(f"Fig. 6: ICE (left) and ISE (right) over the grid on disk, K = {k:g} N/m "
                  "(green: KD at d = 5000; white: its level)")
-    figures.save(fig, f"fig6-maps-{_stiffness_id(k)}")
+    figures.save(fig, f"fig6-maps-{name}")
 
 
 def _path_figure(k: float, path: pd.DataFrame, ratio: pd.DataFrame, figures: Figures) -> None:
@@ -223,7 +223,7 @@ def _maps_bands_figure(grid: pd.DataFrame, figures: Figures) -> None:
             row = points[points["hd_xyz"] == 0].sort_values("d_xyz")
             left.plot(row["d_xyz"], row["ice"] / 1e3, style, marker=marker, color=color, ms=3, lw=1,
                       label=f"{implementation}, inertia ×{inertia}")
-            level, locus = equal_ice_locus(points)
+            _, locus = equal_ice_locus(points)
             if len(locus) >= 2:
                 d, hd = np.array(locus).T
                 right.plot(d, hd, style, marker=marker, color=color, ms=3, lw=1)

@@ -11,6 +11,7 @@ from analysis.core.metrics import MetricTable
 from analysis.core.targets import paper_value
 from pipeline.core.runlog import Run
 from pipeline.core.runner import run_id
+from pipeline.papers.scara_half_derivative.arm import gravity_torque, jacobian
 
 AXES = ("x", "y", "z")
 
@@ -166,6 +167,14 @@ def ice_argmin(grid: pd.DataFrame) -> float:
     return float(row.loc[row["ice"].idxmin(), "d_xyz"]) if len(row) else float("nan")
 
 
+def rising_fraction(grid: pd.DataFrame, metric: str) -> float:
+    """The fraction of the grid's steps (along d and along hd) over which `metric` rises."""
+    table = grid.pivot(index="d_xyz", columns="hd_xyz", values=metric).to_numpy()
+    steps = np.concatenate([np.diff(table, axis=0).ravel(), np.diff(table, axis=1).ravel()])
+    steps = steps[np.isfinite(steps)]
+    return float((steps > 0).mean()) if len(steps) else float("nan")
+
+
 def _monotonic(grid: pd.DataFrame, metric: str, sign: int) -> bool:
     """`metric` changes with the sign `sign` along every grid line of d and of hd."""
     table = grid.pivot(index="d_xyz", columns="hd_xyz", values=metric)
@@ -189,3 +198,17 @@ def paper_table2() -> dict[str, tuple[float, float, float]]:
 
 
 SCALE = {"e": 1e3}   # m -> mm for the error rows
+
+
+def stiffness_bound(arm, q) -> float:
+    """The largest k_xyz Table 2's KD column allows (arithmetic on the paper's numbers and its kinematics): where
+    |e_a| peaks, ė_a = 0 and KD's Cartesian force has |F| ≥ k |e_a|; the torque it takes, J^T F = τ − τ_g, has a
+    norm of at least σ_min(J) |F|, and at most ‖(τ1max, τ2max, τ3max + max|τ_g,3|)‖. So k ≤ that norm /
+    (σ_min · max_a e_a,max), with σ_min the least singular value of the translational Jacobian (eq. 7) over the
+    set-point's poses `q` (the arm is within mm of them) and τ_g,3 of eq. (12) along them."""
+    paper = paper_table2()
+    sigma = np.linalg.svd(jacobian(arm, q)[:, :3, :3], compute_uv=False)[:, -1].min()
+    gravity = np.abs(gravity_torque(arm, q[:, 2])).max()
+    torque = np.hypot(np.hypot(paper["tau1.max"][0], paper["tau2.max"][0]), paper["tau3.max"][0] + gravity)
+    error = max(paper[f"e.{a}.max"][0] for a in AXES) * 1e-3   # Table 2 prints mm
+    return float(torque / (sigma * error))

@@ -272,9 +272,9 @@ def feasible_path(arm: Arm, q_ref: np.ndarray, obstacles: Obstacles, band: tuple
                   inside: float) -> np.ndarray:
     """(n, 6) joints that follow the reference γ but keep the wrist point `inside` (m) within the constraints of
     a Table 3 case: the wrist height clipped into the band (10g), then pushed out of the obstacle's safety
-    sphere (10f), radially (no band) or horizontally (band); the tool keeps the reference's orientation (IK
-    branch of the reference). Where a closed loop would be when its reference runs into a constraint, so the
-    OCPs sampled on it meet their constraints active, as in the loop."""
+    sphere (10f): radially without a band; with one, up as far as the band allows, then horizontally; the tool
+    keeps the reference's orientation (IK branch of the reference). Where a closed loop would be when its
+    reference runs into a constraint, so the OCPs sampled on it meet their constraints active, as in the loop."""
     wrist_ref = kin.wrist_point(arm, q_ref[:, :3])
     wrist = wrist_ref.copy()
     if band is not None:
@@ -286,6 +286,10 @@ def feasible_path(arm: Arm, q_ref: np.ndarray, obstacles: Obstacles, band: tuple
             push = distance < radius
             wrist[push] = centre + away[push] * (radius / distance[push])[:, None]
         else:
+            inside_sphere = np.linalg.norm(away, axis=1) < radius
+            top = band[1] - inside
+            wrist[inside_sphere, 2] = np.maximum(wrist[inside_sphere, 2], min(top, centre[2] + radius))
+            away = wrist - centre
             horizontal = np.linalg.norm(away[:, :2], axis=1)
             reach = np.sqrt(np.maximum(radius ** 2 - away[:, 2] ** 2, 0.0))
             push = horizontal < reach
@@ -317,10 +321,10 @@ def _probe_start(cfg: DictConfig, arm: Arm, m: dict, case: str, k: int, tick: in
 def _moves_loop(cfg: DictConfig, arm: Arm, moves: list[dict], model: str, case: str, k: int):
     """One (model, case, horizon) over all moves, pausing after every OCP solve; returns (move index,
     trajectory, obstacles, untimed solves). `scenario.sampling=closed-loop`: every OCP of every move's closed
-    loop; `states`: at `scenario.samples_per_move` updates drawn along each move, a probe of two OCPs from
-    the feasible path there: the first (cold, guessed from that path) warms the second up, which the loop would
-    have solved next (its state the first plan's prediction, its guess the first solution shifted): only the
-    second is timed."""
+    loop; `states`: at `scenario.samples_per_move` updates drawn along each move, the OCP the closed loop solves
+    there, timed after a probe of `scenario.probe_solves - 1` OCPs that starts that many control horizons
+    earlier on the feasible path (the first cold, guessed from that path; each next one from the previous
+    plan's prediction, guessed from its solution shifted, as in the loop)."""
     sc = cfg.scenario
     obstacles_of = lambda m: _case_setup(cfg, m, case)[0]  # noqa: E731
     nmpc = nmpc_of(cfg, arm, model, k, int(case != "no-obstacle"), case == "obstacle-height")
@@ -332,10 +336,12 @@ def _moves_loop(cfg: DictConfig, arm: Arm, moves: list[dict], model: str, case: 
             tr = yield from closed_loop(arm, nmpc, ctl, move, plant, m["selection"])
             trajectories.append((index, tr, move.obstacles, 0))
             continue
-        for tick in m["ticks"]:
-            start = _probe_start(cfg, arm, m, case, k, tick)
-            tr = yield from closed_loop(arm, nmpc, ctl, move, plant, m["selection"], start, solves=2)
-            trajectories.append((index, tr, move.obstacles, 1))
+        for tick in m["ticks"]:   # the probe starts `probe_solves - 1` OCPs before the timed one
+            first = max(0, tick - (sc.probe_solves - 1) * ctl.control_steps)
+            start = _probe_start(cfg, arm, m, case, k, first)
+            solves = (tick - first) // ctl.control_steps + 1
+            tr = yield from closed_loop(arm, nmpc, ctl, move, plant, m["selection"], start, solves=solves)
+            trajectories.append((index, tr, move.obstacles, solves - 1))
     return trajectories
 
 

@@ -88,5 +88,5 @@ def _runs_steps(runs) -> Budget:
 
 _TABLE2 = _runs_steps(lambda c: len(c.scenario.controllers) * len(c.scenario.k_xyz))
 _MAPS = _runs_steps(lambda c: _count(c.scenario.k_xyz) * len(c.scenario.d_xyz) * len(c.scenario.hd_xyz))
-BUDGETS = {"table2": _TABLE2, "table2-sensitivity": _TABLE2, "stiffness": _TABLE2, "maps": _MAPS, "maps-sensitivity": _MAPS,
-           "locus": _runs_steps(lambda c: len(c.scenario.k_xyz) * len(c.scenario.d_xyz))}
+BUDGETS = {"table2": _TABLE2, "table2-sensitivity": _TABLE2, "stiffness": _TABLE2, "maps": _MAPS,
+           "maps-sensitivity": _MAPS, "locus": _runs_steps(lambda c: len(c.scenario.k_xyz) * len(c.scenario.d_xyz))}
