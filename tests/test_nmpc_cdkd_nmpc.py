@@ -126,7 +126,7 @@ def table3_cfg():
 def test_a_probe_resumes_the_closed_loop(table3_cfg):
     """Started where a closed loop stands (its command, its last two inputs, its previous plan shifted), a probe
     solves the OCP the loop solved there: the same plan."""
-    from pipeline.papers.nmpc_cdkd.simulation import Start, closed_loop
+    from pipeline.papers.nmpc_cdkd.simulation import Start
 
     cfg = table3_cfg
     arm = ex.arm_of(cfg)
