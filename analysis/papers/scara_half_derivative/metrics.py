@@ -6,7 +6,6 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from analysis.core.errors import error_stats
 from analysis.core.metrics import MetricTable
 from analysis.core.targets import paper_value
 from pipeline.core.runlog import Run
@@ -14,9 +13,6 @@ from pipeline.core.runner import run_id
 from pipeline.papers.scara_half_derivative.arm import gravity_torque, jacobian
 
 AXES = ("x", "y", "z")
-
-
-JOINT_TORQUES = [f"value.theta{i}" for i in range(1, 5)]
 
 
 NOISE = 1e-9                 # SI: a reference value this small is round-off (τ4 ≡ 0 in the model)
@@ -45,7 +41,7 @@ SWING = 5e-6                 # m: an error reversal this large counts as one swi
 
 
 def _model(run: Run) -> dict:
-    return yaml.safe_load(run.attachments["model.yaml"])
+    return yaml.load(run.attachments["model.yaml"], Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
 
 
 def _tuning(run: Run) -> dict[str, float]:
@@ -74,22 +70,18 @@ def aggregate_id(name: str, run: Run) -> str:
 
 
 def tuning_metrics(run: Run) -> dict[str, tuple[float, str]]:
-    """Table 2's indexes, ICE and the Exudyn loop gap of one closed-loop run."""
-    err = run["/tracking_error"]
-    t = err.index.to_numpy()
+    """Table 2's indexes, ISE (eq. 19), ICE (eq. 18) and the Exudyn loop gap of one closed-loop run: the
+    indexes as the run computed them on its integration steps (`/closed_loop/indexes`; a test checks them
+    against the logged signals)."""
+    row = run["/closed_loop/indexes"].iloc[0]
     values: dict[str, tuple[float, str]] = {}
-    ise = 0.0
-    for axis in AXES:
-        stats = error_stats(t, err[f"error.{axis}"].to_numpy(), f"e.{axis}", "m")
-        values |= {k: stats[k] for k in (f"e.{axis}.max", f"e.{axis}.mean")}
-        ise += stats[f"e.{axis}.ise"][0]
-    values["ise"] = (ise, "m^2*s")   # eq. (19)
-    command = run["/command"]
-    tau = command[JOINT_TORQUES].to_numpy()
-    period = float(np.diff(command.index.to_numpy()).mean())
-    values["ice"] = (float((tau ** 2).sum() * period), "N^2*m^2*s")   # eq. (18), torques held over each period
+    for i, axis in enumerate(AXES):
+        values[f"e.{axis}.max"] = (float(row[f"e_max_m[{i}]"]), "m")
+        values[f"e.{axis}.mean"] = (float(row[f"e_mean_m[{i}]"]), "m")
+    values["ise"] = (float(row["ise_m2s"]), "m^2*s")
+    values["ice"] = (float(row["ice_N2m2s"]), "N^2*m^2*s")
     for i in range(4):
-        values[f"tau{i + 1}.max"] = (float(np.abs(tau[:, i]).max()), "Nm")
+        values[f"tau{i + 1}.max"] = (float(row[f"tau_max_Nm[{i}]"]), "Nm")
     if "/loop_closure" in run.topic_names:
         values["loop_gap.max"] = (float(run["/loop_closure"]["value.gap"].abs().max()), "m")
     return values

@@ -19,6 +19,26 @@ from pipeline.papers.scara_half_derivative.closed_loop import ClosedLoopRun, Pla
 from pipeline.papers.scara_half_derivative.controller import CartesianController, Gains
 from pipeline.papers.scara_half_derivative.setpoint import Motion
 
+Indexes = schemas.define(
+    "ClosedLoopIndexes", "Table 2's indexes and eqs. (18)-(19) of one closed-loop run over [0, T_sim], on every "
+    "integration step: max and mean |e| of x, y, z in that order (m), ISE = ∫(e_x² + e_y² + e_z²) dt "
+    "(trapezoid, m²s), ICE = Σ_i ∫τ_i² dt of the applied torques (N²m²s), max |τ_i| of joints 1-4 (N m).",
+    e_max_m="double[]", e_mean_m="double[]", ise_m2s="double", ice_N2m2s="double", tau_max_Nm="double[]",
+)
+
+
+def indexes(arm: Arm, motion: Motion, run: ClosedLoopRun, period: float) -> dict:
+    """The fields of `Indexes` from the run's integration steps: the analysis reads these instead of decoding
+    every logged sample (a map sweep has hundreds of runs)."""
+    e = motion(run.t)[0][:, :3] - fk(arm, run.q)[:, :3]
+    if run.tau_fine is None:
+        tau, step = run.tau, period
+    else:
+        tau, step = run.tau_fine, float(run.t[1] - run.t[0])
+    return {"e_max_m": np.abs(e).max(axis=0).tolist(),
+            "e_mean_m": np.abs(e).mean(axis=0).tolist(), "ise_m2s": float(np.trapezoid((e ** 2).sum(axis=1), run.t)),
+            "ice_N2m2s": float((tau ** 2).sum() * step), "tau_max_Nm": np.abs(tau).max(axis=0).tolist()}
+
 
 def arm_of(cfg: DictConfig) -> Arm:
     return Arm.from_config(cfg.system)
@@ -85,6 +105,7 @@ def log_closed_loop(log: RunWriter, cfg: DictConfig, arm: Arm, motion: Motion, r
     log.log_series("/tracking_error", t, name=list(EXTERNAL), error=error,
                    norm=np.linalg.norm(error[:, :3], axis=1))
     log.log_series("/command", t_tau, kind="torque", name=list(JOINTS), value=tau)
+    log.log("/closed_loop/indexes", float(run.t[-1]), Indexes, **indexes(arm, motion, run, cfg.system.control.dt))
     if np.isfinite(run.controller_s).all():   # a batch times no single controller
         log.log_series("/compute_time", run.t_control, name=[law], seconds=run.controller_s[:, None], calls=[1])
     if run.loop_residual is not None:
