@@ -210,6 +210,38 @@ def test_a_band_counts_only_ok_runs_of_its_own_case():
     assert not self_check(alone)
 
 
+def test_a_band_counts_the_aggregates_of_its_sweep_points():
+    """A value the analysis writes per sweep point (a fit over a map: `r1__k=2`, not a run) is part of the band;
+    a failed run's rows are not."""
+    sweep = pd.DataFrame([{"run_id": r, "metric": "m", "value": v, "unit": "m"}
+                          for r, v in (("r1__k=1", 1.4), ("r1__k=2", 1.0), ("r1__k=3", 0.5))])
+    runs = pd.concat([_runs(("r1", "ok")), pd.DataFrame([{"experiment": "sweep", "run_id": "r1__k=3",
+                                                         "status": "failed: diverged"}])])
+    row = evaluate("p", _targets(band="sweep", cause="parameter-missing"), _metrics(1.5) | {"sweep": sweep},
+                   runs).iloc[0]
+    assert row["status"] == "consistent" and (row["band_min"], row["band_max"]) == (1.0, 1.4)
+
+
+def test_a_band_reaches_the_paper_within_its_tolerance():
+    """1.0 ± 0.1: a band [1.08, 1.3] holds a value that would match; [1.15, 1.3] does not."""
+    assert _banded(1.5, {"r1__k=1": 1.08, "r1__k=2": 1.3})["status"] == "consistent"
+    assert _banded(1.5, {"r1__k=1": 1.15, "r1__k=2": 1.3}, cause="model-limitation")["status"] == "miss"
+
+
+def test_a_default_without_a_value_can_be_consistent_unless_it_failed():
+    """No value where the default did not fail (an aggregate with nothing to fit) is a miss a band may explain;
+    a failed default run stays a miss."""
+    sweep = pd.DataFrame([{"run_id": "r1__k=1", "metric": "m", "value": 1.02, "unit": "m"}])
+    empty = {"exp": pd.DataFrame([{"run_id": "r1", "metric": "other", "value": 0.0, "unit": "m"}])}
+    runs = pd.concat([_runs(("r0", "ok")), pd.DataFrame([{"experiment": "sweep", "run_id": "r1__k=1",
+                                                         "status": "ok"}])])
+    row = evaluate("p", _targets(band="sweep", cause="parameter-missing"), empty | {"sweep": sweep}, runs).iloc[0]
+    assert row["status"] == "consistent" and math.isnan(row["pipeline_value"])
+    failed = pd.concat([runs, _runs(("r1", "failed: diverged"))])
+    row = evaluate("p", _targets(band="sweep", cause="paper-inconsistent"), {"sweep": sweep}, failed).iloc[0]
+    assert row["status"] == "miss" and "diverged" in row["note"]
+
+
 def test_self_check_refuses_a_missing_parameter_its_band_cannot_explain():
     bad = _banded(1.5, {"r1__k=1": 1.4, "r1__k=2": 1.6})                  # parameter-missing, band misses
     assert bad["status"] == "miss"
