@@ -162,15 +162,16 @@ def analyze_maps_sensitivity(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-def analyze_locus(runs: list[Run], figures: Figures) -> pd.DataFrame:
+def analyze_locus(runs: list[Run], figures: Figures | None) -> pd.DataFrame:
+    """Fig. 7 per stiffness (and sweep point); `figures` None draws none (the sensitivity sweep)."""
     m = MetricTable()
     grid = grid_frame(runs)
     for row in grid.to_dict("records"):
         params = {key: row[key] for key in ("k_xyz", "d_xyz", "hd_xyz")}
         for name, unit in (("ise", "m^2*s"), ("ice", "N^2*m^2*s"), *((f"tau{i}.max", "Nm") for i in range(1, 5))):
             m.add(row["run_id"], name, row[name], unit, params)
-    for k, path in grid.groupby("k_xyz"):
-        sid = _stiffness_id(k)
+    for sid, path in grid.groupby("group"):   # per stiffness (and sweep point)
+        k = float(path["k_xyz"].iloc[0])
         path = path.sort_values("d_xyz", ascending=False)
         kd = path[np.isclose(path["d_xyz"], KD_DAMPING)]
         if kd.empty:
@@ -184,10 +185,11 @@ def analyze_locus(runs: list[Run], figures: Figures) -> pd.DataFrame:
         if not middle.empty:
             change = (ratio.loc[middle.index[0], torques] - 1).abs().max()
             m.add(sid, "middle.max_torque_change", float(change), "fraction")
-        _path_figure(k, path, ratio, figures)
+        if figures is not None:
+            _path_figure(k, path, ratio, figures, sid)
     return m.frame()
 
 
 ANALYSES = {"setpoint": analyze_setpoint, "table2": analyze_table2, "maps": analyze_maps, "locus": analyze_locus,
             "table2-sensitivity": analyze_table2_sensitivity, "maps-sensitivity": analyze_maps_sensitivity,
-            "stiffness": analyze_stiffness}
+            "stiffness": analyze_stiffness, "locus-sensitivity": lambda runs, figures: analyze_locus(runs, None)}

@@ -125,7 +125,7 @@ def _map_figure(k: float, grid: pd.DataFrame, level: float, points: list, figure
     figures.save(fig, f"fig6-maps-{name}")
 
 
-def _path_figure(k: float, path: pd.DataFrame, ratio: pd.DataFrame, figures: Figures) -> None:
+def _path_figure(k: float, path: pd.DataFrame, ratio: pd.DataFrame, figures: Figures, name: str) -> None:
     fig, (left, right) = plt.subplots(1, 2, figsize=(10, 3.6))
     d = path["d_xyz"].to_numpy()
     left.plot(d, path["ise"], "o-", color="C0", label="ISE")
@@ -144,7 +144,7 @@ def _path_figure(k: float, path: pd.DataFrame, ratio: pd.DataFrame, figures: Fig
     right.invert_xaxis()
     right.legend(ncol=2)
     fig.suptitle(f"Fig. 7: along eq. (20), KD (d = 5000) to KHD (d = 0), K = {k:g} N/m")
-    figures.save(fig, f"fig7-path-{_stiffness_id(k)}")
+    figures.save(fig, f"fig7-path-{name}")
 
 
 BAND_ROWS = ("e.x.max", "e.y.max", "e.z.max", "e.x.mean", "e.y.mean", "e.z.mean", "ise", "tau1.max", "tau2.max",

@@ -33,7 +33,8 @@ def __getattr__(name: str):
 
         return {"setpoint": experiments.setpoint, "table2": experiments.table2, "maps": experiments.maps,
                 "locus": experiments.locus, "table2-sensitivity": experiments.table2,
-                "maps-sensitivity": experiments.maps, "stiffness": experiments.table2}
+                "maps-sensitivity": experiments.maps, "stiffness": experiments.table2,
+                "locus-sensitivity": experiments.locus}
     raise AttributeError(name)
 
 
@@ -87,6 +88,7 @@ def _runs_steps(runs) -> Budget:
 
 
 _TABLE2 = _runs_steps(lambda c: len(c.scenario.controllers) * len(c.scenario.k_xyz))
+_LOCUS = _runs_steps(lambda c: len(c.scenario.k_xyz) * len(c.scenario.d_xyz))
 _MAPS = _runs_steps(lambda c: _count(c.scenario.k_xyz) * len(c.scenario.d_xyz) * len(c.scenario.hd_xyz))
 BUDGETS = {"table2": _TABLE2, "table2-sensitivity": _TABLE2, "stiffness": _TABLE2, "maps": _MAPS,
-           "maps-sensitivity": _MAPS, "locus": _runs_steps(lambda c: len(c.scenario.k_xyz) * len(c.scenario.d_xyz))}
+           "maps-sensitivity": _MAPS, "locus": _LOCUS, "locus-sensitivity": _LOCUS}
