@@ -12,10 +12,12 @@ from __future__ import annotations
 
 from foxglove_schemas_protobuf.ArrowPrimitive_pb2 import ArrowPrimitive
 from foxglove_schemas_protobuf.Color_pb2 import Color
+from foxglove_schemas_protobuf.CubePrimitive_pb2 import CubePrimitive
 from foxglove_schemas_protobuf.CylinderPrimitive_pb2 import CylinderPrimitive
 from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
 from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
 from foxglove_schemas_protobuf.JointStates_pb2 import JointStates
+from foxglove_schemas_protobuf.LinePrimitive_pb2 import LinePrimitive
 from foxglove_schemas_protobuf.Point3_pb2 import Point3
 from foxglove_schemas_protobuf.Pose_pb2 import Pose
 from foxglove_schemas_protobuf.PosesInFrame_pb2 import PosesInFrame
@@ -124,10 +126,12 @@ __all__ = [
     "TOPICS",
     "ArrowPrimitive",
     "Color",
+    "CubePrimitive",
     "CylinderPrimitive",
     "FrameTransform",
     "FrameTransforms",
     "JointStates",
+    "LinePrimitive",
     "Point3",
     "Pose",
     "PosesInFrame",
