@@ -203,7 +203,7 @@ def _table2_bands_figure(frame: pd.DataFrame, figures: Figures) -> None:
         axes[0].set_yticks(range(len(BAND_ROWS)), BAND_ROWS)
         axes[0].invert_yaxis()
         axes[-1].legend(fontsize=7, loc="lower right")
-        fig.suptitle(f"Table 2 over the sweep (implementation × inertia scale × T_sim), K = {k:g} N/m: grey = band")
+        fig.suptitle(f"Table 2 over the sweep (implementation × inertia scale), K = {k:g} N/m: grey = band")
         figures.save(fig, f"table2-bands-{_stiffness_id(k)}")
 
 

@@ -86,8 +86,8 @@ def _stride(log_dt: float, dt: float, what: str) -> int:
 
 def log_closed_loop(log: RunWriter, cfg: DictConfig, arm: Arm, motion: Motion, run: ClosedLoopRun, law: str) -> None:
     """Fine-step signals every `execute.log_dt`, the torques (held over each control period, or at every
-    integration step when they vary within it), controller times, link frames every `execute.tf_dt`, and
-    Exudyn's loop-closure gap."""
+    integration step when they vary within it; every `execute.log_dt` when that is longer), controller times,
+    link frames every `execute.tf_dt`, and Exudyn's loop-closure gap."""
     ex = cfg.execute
     dt = float(run.t[1] - run.t[0])
     fine = slice(None, None, _stride(ex.log_dt, dt, "execute.log_dt"))
@@ -99,12 +99,13 @@ def log_closed_loop(log: RunWriter, cfg: DictConfig, arm: Arm, motion: Motion, r
         t_tau, tau = run.t[:-1], run.tau_fine
     step = float(t_tau[1] - t_tau[0]) if len(t_tau) > 1 else dt
     held = tau[np.minimum((t / step + 1e-9).astype(int), len(tau) - 1)]
+    command = slice(None, None, max(1, round(ex.log_dt / step)))   # a sweep's runs are logged to look at
     error = x_d - fk(arm, q)
     log.log_series("/reference", t, name=list(EXTERNAL), position=x_d, velocity=xd_d, acceleration=xdd_d)
     log.log_series("/joint_state", t, name=list(JOINTS), position=q, velocity=qd, effort=held)
     log.log_series("/tracking_error", t, name=list(EXTERNAL), error=error,
                    norm=np.linalg.norm(error[:, :3], axis=1))
-    log.log_series("/command", t_tau, kind="torque", name=list(JOINTS), value=tau)
+    log.log_series("/command", t_tau[command], kind="torque", name=list(JOINTS), value=tau[command])
     log.log("/closed_loop/indexes", float(run.t[-1]), Indexes, **indexes(arm, motion, run, cfg.system.control.dt))
     if np.isfinite(run.controller_s).all():   # a batch times no single controller
         log.log_series("/compute_time", run.t_control, name=[law], seconds=run.controller_s[:, None], calls=[1])
