@@ -113,3 +113,62 @@ def test_compute_time_runs_on_the_kinematic_plant(data_dir):
     runs = [read_run(p) for p in run_files(data_dir / "runs/nmpc-cdkd/compute-time")]
     assert len(runs) == 2 and all(r.ok for r in runs), [r.status for r in runs]
     assert "effort" not in " ".join(runs[0]["/joint_state"].columns)  # a kinematic plant has no torques
+
+
+# -- Table 3's probes ---------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def table3_cfg():
+    return compose_config(["experiment=nmpc-cdkd/compute-time", "scenario.moves=1"])
+
+
+def test_a_probe_resumes_the_closed_loop(table3_cfg):
+    """Started where a closed loop stands (its command, its last two inputs, its previous plan shifted), a probe
+    solves the OCP the loop solved there: the same plan."""
+    from pipeline.papers.nmpc_cdkd.simulation import Start
+
+    cfg = table3_cfg
+    arm = ex.arm_of(cfg)
+    m = ex.random_moves(cfg, arm)[0]
+    move = ex._move_of(cfg, m, "no-obstacle")
+    nmpc = ex.nmpc_of(cfg, arm, "decomposed", 10, 0, False)
+    ctl = ex.controller_of(cfg)
+    plant = ex.plant_factory(cfg, arm, move.obstacles, None)
+    loop = run(arm, nmpc, ctl, move, plant, m["selection"], solves=4)
+    j, cs = 3 * ctl.control_steps, ctl.control_steps                   # the loop's fourth OCP
+    previous = loop.solves[2]
+    shifted = np.concatenate([previous.x[cs:, 3:6], np.repeat(previous.x[-1:, 3:6], cs, axis=0)])
+    guess_q = np.concatenate([shifted, np.tile(loop.q_cmd[j, 3:], (len(shifted), 1))], axis=1)
+    guess_u = np.concatenate([previous.u[cs:], np.repeat(previous.u[-1:], cs, axis=0)])
+    start = Start(tick=j, q=loop.q_cmd[j], u_prev=loop.qd_cmd[[j - 1, j - 2]],
+                  guess_q=guess_q, guess_u=np.pad(guess_u, ((0, 0), (0, 3))))
+    probe = run(arm, nmpc, ctl, move, plant, m["selection"], start, solves=1)
+    assert len(probe.solves) == 1 and probe.solve_t[0] == pytest.approx(loop.solve_t[3])
+    np.testing.assert_allclose(probe.solves[0].u, loop.solves[3].u, atol=1e-5)
+    assert np.abs(loop.solves[3].u).max() > 0.1                           # the arm is moving there
+
+
+def test_the_probes_feasible_path_keeps_the_constraints(table3_cfg):
+    """The feasible path keeps the wrist out of the obstacle's safety sphere and inside the height band, and is the
+    reference wherever the reference keeps them itself."""
+    cfg = table3_cfg
+    arm = ex.arm_of(cfg)
+    m = ex.random_moves(cfg, arm)[0]
+    poly = ex.planning.JointPolynomial(m["selection"].q_start, m["selection"].q_goal, 0.0, m["T"])
+    q_ref = poly(np.linspace(0.0, m["T"], 120))
+    for case in ("obstacle", "obstacle-height"):
+        move = ex._move_of(cfg, m, case)
+        path = ex.feasible_path(arm, q_ref, move.obstacles, move.band, 0.001)
+        wrist, wrist_ref = kin.wrist_point(arm, path[:, :3]), kin.wrist_point(arm, q_ref[:, :3])
+        safety = move.obstacles.radii[0] + arm.safety_radius
+        assert (np.linalg.norm(wrist - move.obstacles.centres[0], axis=1) >= safety - 1e-9).all()
+        if move.band is not None:
+            assert (wrist[:, 2] >= move.band[0] - 1e-9).all() and (wrist[:, 2] <= move.band[1] + 1e-9).all()
+        free = np.linalg.norm(wrist_ref - move.obstacles.centres[0], axis=1) > safety + 0.001
+        if move.band is None:
+            np.testing.assert_array_equal(path[free], q_ref[free])
+        assert (~free).any()                                               # the reference runs into the obstacle
+        # the tool keeps the reference's orientation
+        np.testing.assert_allclose(kin.tool_pose(arm, path)[:, :3, :3], kin.tool_pose(arm, q_ref)[:, :3, :3],
+                                   atol=1e-9)

@@ -132,6 +132,34 @@ def test_not_run_and_failed_runs():
     assert aggregate["status"] == "miss" and "r2 failed: unstable" in aggregate["note"]
 
 
+def _interval_metrics(median: float, low: float, high: float) -> dict[str, pd.DataFrame]:
+    return {"exp": pd.DataFrame([{"run_id": "r1", "metric": m, "value": v, "unit": "m"} for m, v in
+                                 (("m", median), ("m.ci_low", low), ("m.ci_high", high))])}
+
+
+@pytest.mark.parametrize(("low", "high", "status"), [
+    (0.8, 1.3, "match"),          # the paper's 1.0 inside our interval, although the median is 1.2 (> 1.1 away)
+    (1.0, 1.3, "match"),          # on the bound
+    (1.05, 1.3, "miss"),          # excluded, however near: an interval has no `close`
+    (0.5, 0.99, "miss"),
+    (float("nan"), float("nan"), "miss"),   # no interval written: nothing supports a match
+])
+def test_interval_rule(low, high, status):
+    """tolerance `ci`: the paper's value against the interval the analysis writes beside the metric."""
+    row = evaluate("p", _targets(tolerance="ci"), _interval_metrics(1.2, low, high), _runs(("r1", "ok"))).iloc[0]
+    assert row["status"] == status and row["pipeline_value"] == pytest.approx(1.2)
+    assert row["tolerance"] == "95% CI" and "95 % interval" in row["note"]
+    if status == "miss":
+        assert row["cause"] == "open"
+
+
+def test_interval_rule_judges_equality_only(tmp_path):
+    path = tmp_path / "targets.csv"
+    _targets(tolerance="ci", op="<=").to_csv(path, index=False)
+    with pytest.raises(ValueError, match="tolerance `ci` judges `==`"):
+        load_targets(path)
+
+
 def test_consistency_rows_are_never_reproductions():
     agree = evaluate("p", _targets(mode="consistency", basis="paper"), _metrics(1.0), _runs(("r1", "ok"))).iloc[0]
     assert agree["status"] == "agrees"
@@ -180,6 +208,38 @@ def test_a_band_counts_only_ok_runs_of_its_own_case():
     alone = evaluate("p", _targets(band="sweep", cause="parameter-missing"), _metrics(1.5), _runs(("r1", "ok")))
     assert alone.iloc[0]["status"] == "miss" and math.isnan(alone.iloc[0]["band_min"])
     assert not self_check(alone)
+
+
+def test_a_band_counts_the_aggregates_of_its_sweep_points():
+    """A value the analysis writes per sweep point (a fit over a map: `r1__k=2`, not a run) is part of the band;
+    a failed run's rows are not."""
+    sweep = pd.DataFrame([{"run_id": r, "metric": "m", "value": v, "unit": "m"}
+                          for r, v in (("r1__k=1", 1.4), ("r1__k=2", 1.0), ("r1__k=3", 0.5))])
+    runs = pd.concat([_runs(("r1", "ok")), pd.DataFrame([{"experiment": "sweep", "run_id": "r1__k=3",
+                                                         "status": "failed: diverged"}])])
+    row = evaluate("p", _targets(band="sweep", cause="parameter-missing"), _metrics(1.5) | {"sweep": sweep},
+                   runs).iloc[0]
+    assert row["status"] == "consistent" and (row["band_min"], row["band_max"]) == (1.0, 1.4)
+
+
+def test_a_band_reaches_the_paper_within_its_tolerance():
+    """1.0 ± 0.1: a band [1.08, 1.3] holds a value that would match; [1.15, 1.3] does not."""
+    assert _banded(1.5, {"r1__k=1": 1.08, "r1__k=2": 1.3})["status"] == "consistent"
+    assert _banded(1.5, {"r1__k=1": 1.15, "r1__k=2": 1.3}, cause="model-limitation")["status"] == "miss"
+
+
+def test_a_default_without_a_value_can_be_consistent_unless_it_failed():
+    """No value where the default did not fail (an aggregate with nothing to fit) is a miss a band may explain;
+    a failed default run stays a miss."""
+    sweep = pd.DataFrame([{"run_id": "r1__k=1", "metric": "m", "value": 1.02, "unit": "m"}])
+    empty = {"exp": pd.DataFrame([{"run_id": "r1", "metric": "other", "value": 0.0, "unit": "m"}])}
+    runs = pd.concat([_runs(("r0", "ok")), pd.DataFrame([{"experiment": "sweep", "run_id": "r1__k=1",
+                                                         "status": "ok"}])])
+    row = evaluate("p", _targets(band="sweep", cause="parameter-missing"), empty | {"sweep": sweep}, runs).iloc[0]
+    assert row["status"] == "consistent" and math.isnan(row["pipeline_value"])
+    failed = pd.concat([runs, _runs(("r1", "failed: diverged"))])
+    row = evaluate("p", _targets(band="sweep", cause="paper-inconsistent"), {"sweep": sweep}, failed).iloc[0]
+    assert row["status"] == "miss" and "diverged" in row["note"]
 
 
 def test_self_check_refuses_a_missing_parameter_its_band_cannot_explain():

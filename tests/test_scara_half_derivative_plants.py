@@ -4,6 +4,7 @@ on energy conservation and on open- and closed-loop trajectories (spec §8 check
 
 from __future__ import annotations
 
+import casadi as ca
 import numpy as np
 import pytest
 
@@ -125,3 +126,66 @@ def test_production_plants_give_the_same_metrics(cfg, arm):
                     (run.tau ** 2).sum() * TS))
     for exudyn, lagrange in zip(*out, strict=True):
         np.testing.assert_allclose(exudyn, lagrange, rtol=1e-3)
+
+
+# -- the batched closed loop (maps, paths and sweeps) ---------------------------------------------------------
+
+
+def _single(cfg, arm, g, duration, difference=False):
+    motion, q0 = motion_of(cfg, arm), home(cfg)
+    plant = make_plant(PlantSettings("lagrange", 1e-3, 0.9, 1e-8), arm, q0, np.zeros(4), TS, round(duration / TS))
+    return run_closed_loop(plant, CartesianController(arm, g, TS, 10, difference=difference), motion, duration, TS)
+
+
+@pytest.mark.parametrize("implementation", ["sampled", "sampled-difference"])
+def test_batch_equals_single_runs(cfg, arm, implementation):
+    """Many tunings in one mapped CasADi call give, tuning by tuning, the single closed loop to round-off."""
+    from pipeline.papers.scara_half_derivative.batch import simulate
+
+    tunings = [gains(cfg, 8e4, d, hd)[1] for d, hd in ((5000.0, 0.0), (2500.0, 23600.0), (0.0, 47200.0))]
+    out = simulate(arm, tunings, motion_of(cfg, arm), home(cfg), 0.6, TS, 5, 10, implementation)
+    assert out.failures == [None, None, None]
+    for g, run in zip(tunings, out.runs, strict=True):
+        single = _single(cfg, arm, g, 0.6, difference=implementation == "sampled-difference")
+        assert np.abs(single.q[-1] - home(cfg)).max() > 0.05          # it moved
+        np.testing.assert_allclose(run.q, single.q, atol=1e-12)
+        np.testing.assert_allclose(run.tau, single.tau, atol=1e-8)
+
+
+def test_continuous_law_is_eq_11_at_every_step(cfg, arm):
+    """The `continuous` implementation evaluates eq. (11) + τ_g inside the integrator: the torque it reports at
+    each integration step equals the law computed in NumPy from that step's state and set-point (KD: no held
+    half-derivative), and it differs from the sampled run's held torque within a period."""
+    from pipeline.papers.scara_half_derivative.arm import fk, gravity_torque, jacobian
+    from pipeline.papers.scara_half_derivative.batch import fk_jacobian_sx, simulate
+
+    q = home(cfg) + np.random.default_rng(3).uniform(-0.3, 0.3, (5, 4))
+    sym = ca.SX.sym("q", 4)
+    x_sx, J_sx = fk_jacobian_sx(arm, sym)
+    symbolic = ca.Function("fkj", [sym], [x_sx, J_sx])
+    for qi in q:
+        x, J = (v.full() for v in symbolic(qi))
+        np.testing.assert_allclose(x.ravel(), fk(arm, qi), atol=1e-14)
+        np.testing.assert_allclose(J, jacobian(arm, qi), atol=1e-14)
+
+    _, g = gains(cfg, 8e4, 5000.0, 0.0)
+    motion = motion_of(cfg, arm)
+    run = simulate(arm, [g], motion, home(cfg), 0.4, TS, 5, 10, "continuous").runs[0]
+    t, state = run.t[:-1], np.concatenate([run.q, run.qd], axis=1)[:-1]
+    x_d, xd_d, _ = motion(t)
+    J = jacobian(arm, state[:, :4])
+    force = g.K * (x_d - fk(arm, state[:, :4])) + g.D * (xd_d - np.einsum("nij,nj->ni", J, state[:, 4:]))
+    law = np.einsum("nji,nj->ni", J, force)
+    law[:, 2] += gravity_torque(arm, state[:, 2])
+    np.testing.assert_allclose(run.tau_fine, law, atol=1e-9)
+    assert np.abs(np.diff(run.tau_fine[:5], axis=0)).max() > 1e-3     # not held over the period
+
+
+def test_a_diverging_tuning_fails_alone(cfg, arm):
+    """In a batch, a tuning whose loop diverges is a failure with its reason; the others are unaffected."""
+    from pipeline.papers.scara_half_derivative.batch import simulate
+
+    stable, unstable = gains(cfg, 8e4, 5000.0, 0.0)[1], gains(cfg, 8e5, 5000.0, 0.0)[1]   # 8e5: unstable here
+    out = simulate(arm, [stable, unstable], motion_of(cfg, arm), home(cfg), 0.6, TS, 5, 10, "sampled-difference")
+    assert out.runs[1] is None and out.failures[1].startswith("unstable:")
+    np.testing.assert_allclose(out.runs[0].q, _single(cfg, arm, stable, 0.6, difference=True).q, atol=1e-12)

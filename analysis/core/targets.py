@@ -13,7 +13,10 @@ Each paper has `analysis/papers/<module>/targets.csv` with one row per reported 
   paper against itself (its printed numbers against each other): never a reproduction.
 - `op`: how `value` is compared: `==` (within tolerance), or `<`, `<=`, `>`, `>=` (a bound or ranking)
 - `tolerance`: `<x>` absolute, `<x> rel` relative, `<x> wrap` absolute on angles modulo 2π (±π equal);
-  for an inequality, the margin by which it may fail and still count as close
+  for an inequality, the margin by which it may fail and still count as close; `ci` (with `==`): the analysis
+  writes an interval beside the metric, `<metric>.ci_low` and `<metric>.ci_high` (e.g. a bootstrap 95 %
+  confidence interval), and the target is a match when the paper's value lies inside it, a miss when the
+  interval excludes it (no close); the pipeline value is the metric itself (e.g. the bootstrap median)
 - `basis`: what the pipeline value is computed from: `simulation` (a simulated system), `algorithm` (the
   paper's algorithm run on its inputs: IK, synthesis, planning, …) or `paper` (arithmetic on the paper's
   own printed numbers). A `paper` basis goes with mode `consistency`, and only with it.
@@ -46,12 +49,16 @@ Sensitivity bands. Where a reported number depends on a parameter the paper omit
 - the sweep is an experiment of its own (`<name>` in dvc.yaml with `args: "-m key=a,b,c ..."`); its run ids are
   `<case>__k=v,…` (pipeline/core/runner.py: run_id);
 - the target names that experiment in `band`. Its band is [min, max] of the target's `metric` (converted to the
-  target's unit) over every ok run of the band experiment whose run id is the target's `run` or starts with
-  `<run>__` (band_runs); band_min, band_max are NaN when no such run is on disk;
+  target's unit) over every row of the band experiment whose run id is the target's `run` or starts with
+  `<run>__` (band_runs), the rows of failed runs left out: the ok runs, and the aggregates the analysis writes
+  per sweep point (e.g. a fit over a map, `k80000__<sweep point>`); band_min, band_max are NaN when none is on
+  disk;
 - the default run (`experiment`, `run`) stays the pipeline value and is judged as above. If it is a miss or a
-  close and the band reaches the paper's value, the status is `consistent` (the declared cause is kept:
-  usually `parameter-missing`). "Reaches": for `==` the paper's value lies in [min, max]; for `<`, `<=` the
-  claim holds at the band's min, for `>`, `>=` at its max (some parameter in the range satisfies it);
+  close (a default that did not fail but has no value, e.g. a fit with nothing to fit, counts as a miss) and the
+  band reaches the paper's value, the status is `consistent` (the declared cause is kept: usually
+  `parameter-missing`). "Reaches": some value in the band would be a match: for `==` the band's point nearest
+  the paper's value is within the tolerance of it; for `<`, `<=` the claim holds at the band's min, for `>`,
+  `>=` at its max (some parameter in the range satisfies it);
 - if the band cannot reach the paper's value, the status stays as judged and the declared cause must be
   `model-limitation` or `paper-inconsistent` with the reason in the note (BAND_CAUSES): the parameter the paper
   omits does not explain the gap. `self_check` lists every target that breaks this rule; the report stage prints
@@ -106,20 +113,29 @@ COLUMNS = ["target_id", "category", "quantity", "where", "value", "unit", "mode"
            "cause", "experiment", "run", "metric", "band", "note"]
 
 
+INTERVAL = "ci"                           # the tolerance of a target judged by the interval the analysis writes
+INTERVAL_BOUNDS = (".ci_low", ".ci_high")  # suffixes of that interval's metrics
+
+
 @dataclass(frozen=True)
 class Tolerance:
     value: float = 0.0
     relative: bool = False
     wrap: bool = False
+    interval: bool = False
 
     @classmethod
     def parse(cls, text: str) -> Tolerance:
         parts = str(text).split() if isinstance(text, str) and text.strip() else []
         if not parts:
             return cls()
+        if parts == [INTERVAL]:
+            return cls(interval=True)
         return cls(float(parts[0]), relative="rel" in parts[1:], wrap="wrap" in parts[1:])
 
     def __str__(self) -> str:
+        if self.interval:
+            return "95% CI"
         if not self.value:
             return ""
         return f"{self.value:g}" + (" rel" if self.relative else "") + (" (mod 2π)" if self.wrap else "")
@@ -145,6 +161,10 @@ def load_targets(path: Path) -> pd.DataFrame:
     if not banded.empty:
         raise ValueError(f"{path}: {banded['target_id'].tolist()}: a band belongs to a reproduction target "
                          "(not to a consistency or not-reproducible row)")
+    odd_interval = targets[(targets["tolerance"] == INTERVAL) & (targets["op"] != "==")]
+    if not odd_interval.empty:
+        raise ValueError(f"{path}: {odd_interval['target_id'].tolist()}: the tolerance `{INTERVAL}` judges `==` "
+                         "(the paper's value inside the interval)")
     dupes = targets["target_id"][targets["target_id"].duplicated()].tolist()
     if dupes:
         raise ValueError(f"{path}: duplicate target ids {dupes}")
@@ -174,6 +194,11 @@ def deviation(pipeline: float, paper: float, tol: Tolerance) -> float:
     return math.remainder(d, 2 * math.pi) if tol.wrap else d
 
 
+def judge_interval(low: float, high: float, paper: float) -> str:
+    """match when the paper's value lies in the pipeline's interval [low, high], else miss (no interval: miss)."""
+    return "match" if low <= paper <= high else "miss"   # NaN bounds fail both comparisons
+
+
 def judge(pipeline: float, paper: float, op: str, tol: Tolerance) -> str:
     """match / close / miss of one value."""
     if math.isnan(pipeline):
@@ -200,25 +225,26 @@ def band_runs(run_ids: pd.Series, run: str) -> pd.Series:
     return (run_ids == run) | run_ids.str.startswith(f"{run}__")
 
 
-def band(table: pd.DataFrame | None, ok_runs: set[str], run: str, metric: str, unit: str) -> tuple[float, float]:
-    """[min, max] of `metric` (in `unit`) over the ok runs of a band experiment that belong to `run`; NaN, NaN
-    when none is on disk."""
+def band(table: pd.DataFrame | None, failed_runs: set[str], run: str, metric: str, unit: str) -> tuple[float, float]:
+    """[min, max] of `metric` (in `unit`) over the rows of a band experiment that belong to `run`, but for the
+    rows of its failed runs (ok runs and the analysis's aggregates count); NaN, NaN when none is on disk."""
     if table is None or table.empty:
         return math.nan, math.nan
     rows = table[band_runs(table["run_id"].astype(str), run) & (table["metric"] == metric)
-                 & table["run_id"].isin(ok_runs)]
+                 & ~table["run_id"].astype(str).isin(failed_runs)]
     values = [convert(float(v), u, unit) for v, u in zip(rows["value"], rows["unit"], strict=True)]
     values = [v for v in values if not math.isnan(v)]
     return (min(values), max(values)) if values else (math.nan, math.nan)
 
 
-def reaches(low: float, high: float, paper: float, op: str) -> bool:
-    """Whether a band [low, high] reaches the paper's value: inside it for `==`; for an inequality, the claim
-    holds at the band's favourable end."""
+def reaches(low: float, high: float, paper: float, op: str, tol: Tolerance = Tolerance()) -> bool:
+    """Whether a band [low, high] reaches the paper's value, i.e. some value in it would be a match: for `==` the
+    band's point nearest the paper's value is within the tolerance; for an inequality, the claim holds at the
+    band's favourable end."""
     if math.isnan(low) or math.isnan(high):
         return False
     if op == "==":
-        return low <= paper <= high
+        return judge(min(max(paper, low), high), paper, op, tol) == "match"
     return {"<": low < paper, "<=": low <= paper, ">": high > paper, ">=": high >= paper}[op]
 
 
@@ -235,6 +261,12 @@ def self_check(evaluated: pd.DataFrame) -> list[str]:
             f"declare {' or '.join(BAND_CAUSES)} with the reason" for r in bad.itertuples()]
 
 
+def _metric_of(of_run: pd.DataFrame, metric: str, unit: str) -> float:
+    """One metric of one run's rows, in `unit`; NaN if absent."""
+    hit = of_run[of_run["metric"] == metric]
+    return convert(float(hit["value"].iloc[0]), hit["unit"].iloc[0], unit) if not hit.empty else float("nan")
+
+
 def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
              runs: pd.DataFrame | None = None) -> pd.DataFrame:
     """One row per target with the pipeline's value (in the paper's unit), its deviation and a status.
@@ -244,11 +276,10 @@ def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
     failed say why."""
     runs = pd.DataFrame(columns=["experiment", "run_id", "status"]) if runs is None else runs
     made = {(r.experiment, r.run_id) for r in runs.itertuples()}
-    ok_runs: dict[str, set[str]] = {}
-    for r in runs.itertuples():
-        if r.status == "ok":
-            ok_runs.setdefault(r.experiment, set()).add(str(r.run_id))
     failed = {(r.experiment, r.run_id): r.status for r in runs.itertuples() if r.status != "ok"}
+    failed_runs: dict[str, set[str]] = {}
+    for experiment, run_id in failed:
+        failed_runs.setdefault(experiment, set()).add(str(run_id))
     rows = []
     for t in targets.itertuples(index=False):
         tol = Tolerance.parse(t.tolerance)
@@ -285,12 +316,16 @@ def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
                 row["deviation"] = deviation(value, paper, tol)
                 row["relative_deviation"] = row["deviation"] / abs(paper) if paper else float("nan")
                 row["status"] = judge(value, paper, t.op, tol)
+                if tol.interval:
+                    low, high = (_metric_of(of_run, t.metric + suffix, t.unit) for suffix in INTERVAL_BOUNDS)
+                    row["status"] = judge_interval(low, high, paper)
+                    row["note"] = "; ".join(x for x in (t.note, f"our 95 % interval [{low:.4g}, {high:.4g}]") if x)
             if row["band"]:
-                low, high = band(metrics.get(row["band"]), ok_runs.get(row["band"], set()), t.run, t.metric,
+                low, high = band(metrics.get(row["band"]), failed_runs.get(row["band"], set()), t.run, t.metric,
                                  t.unit)
                 row["band_min"], row["band_max"] = low, high
-                if row["status"] in ("miss", "close") and not math.isnan(row["pipeline_value"]) and reaches(
-                        low, high, float(t.value), t.op):
+                if row["status"] in ("miss", "close") and (t.experiment, t.run) not in failed and reaches(
+                        low, high, float(t.value), t.op, tol):
                     row["status"] = "consistent"
                     row["cause"] = t.cause
             if t.mode == "consistency":

@@ -17,56 +17,36 @@ from analysis.papers.nmpc_cdkd.figures import (
 )
 from analysis.papers.nmpc_cdkd.metrics import (
     ARRIVAL_POSITION,
-    CASE_LABELS,
-    _combo,
     _obstacle_metrics,
     _solve_metrics,
     _trajectory_metrics,
+    case_config,
+    orientation_lag_model,
 )
+from analysis.papers.nmpc_cdkd.table3 import per_seed, table3, timed_solves
 from pipeline.core.runlog import Run
 
 
 def analyze_compute_time(runs: list[Run], figures: Figures) -> pd.DataFrame:
+    """Per run: its timed solves; `table3`: the cells pooled over the seeds with bootstrap intervals of every
+    ratio (table3.py); `table3__seed=<s>`: each seed's own ratios; the NLP sizes of each cell."""
     m = MetricTable()
-    mean, std = {}, {}
     for run in runs:
         values = _solve_metrics(run["/nmpc/solve"])
+        if "/nmpc/problem" in run.topic_names:
+            problem = run["/nmpc/problem"].iloc[0]
+            values |= {f"nlp.{c.removeprefix('value.')}": (float(problem[c]), "count")
+                       for c in problem.index if c.startswith("value.")}
         m.add_run(run, values)
-        mean[_combo(run.run_id)], std[_combo(run.run_id)] = values["solve.mean"][0], values["solve.std"][0]
-    cases = sorted({c for _, c, _ in mean}, key=list(CASE_LABELS).index)
-    horizons = sorted({k for *_, k in mean})
-    table = {}
-    for case in cases:
-        for k in horizons:
-            if ("decomposed", case, k) in mean and ("full", case, k) in mean:
-                table[f"ratio.{case}.k{k}"] = (mean["decomposed", case, k] / mean["full", case, k], "ratio")
-                table[f"sigma_ratio.{case}.k{k}"] = (std["decomposed", case, k] / std["full", case, k], "ratio")
-        for model in ("decomposed", "full"):
-            if len(horizons) == 2 and all((model, case, k) in mean for k in horizons):
-                table[f"growth.{model}.{case}"] = (mean[model, case, horizons[1]] / mean[model, case, horizons[0]] - 1,
-                                                   "fraction")
-    for model in ("decomposed", "full"):
-        for k in horizons:
-            if (model, "no-obstacle", k) in mean and (model, "obstacle-height", k) in mean:
-                table[f"complexity.{model}.k{k}"] = (mean[model, "obstacle-height", k] / mean[model, "no-obstacle", k],
-                                                     "ratio")
-    ratios = [v for key, (v, _) in table.items() if key.startswith("ratio.")]
-    sigma = [v for key, (v, _) in table.items() if key.startswith("sigma_ratio.")]
-    if ratios:
-        table["claim.ratio_max"] = (max(ratios), "ratio")
-        table["claim.ratio_min"] = (min(ratios), "ratio")
-        table["claim.sigma_lower_everywhere"] = (float(all(v < 1 for v in sigma)), "bool")
-    for model in ("decomposed", "full"):
-        growth = [v for key, (v, _) in table.items() if key.startswith(f"growth.{model}.")]
-        if growth:
-            table[f"claim.growth_max.{model}"] = (max(growth), "fraction")
-    complexity = [(table.get(f"complexity.full.k{k}"), table.get(f"complexity.decomposed.k{k}")) for k in horizons]
-    if all(f and d for f, d in complexity):
-        table["claim.full_grows_with_complexity_more"] = (float(all(f[0] > d[0] for f, d in complexity)), "bool")
-    for metric, (value, unit) in table.items():
+    solves = timed_solves(runs)
+    for metric, (value, unit) in table3(solves).items():
         m.add("table3", metric, value, unit)
-    _table3_figure(mean, std, figures)
-    return m.frame()
+    for seed, values in per_seed(solves).items():
+        for metric, value in values.items():
+            m.add(f"table3__seed={seed}", metric, value, "fraction" if "growth" in metric else "ratio")
+    frame = m.frame()
+    _table3_figure(frame, figures)
+    return frame
 
 
 def analyze_tracking(runs: list[Run], figures: Figures) -> pd.DataFrame:
@@ -81,8 +61,9 @@ def analyze_tracking(runs: list[Run], figures: Figures) -> pd.DataFrame:
         values["claim.no_stationary_error"] = (float(values["tool_error.final"][0] < ARRIVAL_POSITION), "bool")
         values["claim.lag_from_orientation"] = (
             float(values["wrist_error.max"][0] < 0.1 * values["tool_error.max"][0]), "bool")
+        values |= orientation_lag_model(run)
         m.add_run(run, values)
-        tool_error[run.metadata["case"]] = (run.config["system"]["dh"]["tool_d"], values["tool_error.max"][0])
+        tool_error[run.metadata["case"]] = (case_config(run)["system"]["dh"]["tool_d"], values["tool_error.max"][0])
         _fig3(run, figures)
     for model in ("decomposed", "full"):  # Sec. 4.2: a shorter d_e gives smaller amplitudes in Fig. 3b
         pairs = sorted(v for case, v in tool_error.items() if case.split("-de")[0] == model)

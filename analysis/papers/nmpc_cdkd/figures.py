@@ -3,27 +3,67 @@
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 
-from analysis.core.figures import Figures, plt
-from analysis.papers.nmpc_cdkd.metrics import XYZ, _obstacle_layout, _xyz, paper_table3
+from analysis.core.figures import PAPER_STYLE, Figures, plt
+from analysis.core.metrics import metric_value
+from analysis.core.targets import paper_value
+from analysis.papers.nmpc_cdkd.metrics import CASE_LABELS, SLUG, XYZ, _obstacle_layout, _xyz
 from pipeline.core.runlog import Run
 
 
-def _table3_figure(mean: dict, std: dict, figures: Figures) -> None:
-    if not mean:
+def _interval(frame: pd.DataFrame, metric: str) -> tuple[float, float, float]:
+    """(median, low, high) of a `table3` metric with its 95 % interval."""
+    return tuple(metric_value(frame, "table3", name) for name in (metric, f"{metric}.ci_low", f"{metric}.ci_high"))
+
+
+def _with_interval(ax, x: float, values: tuple[float, float, float], color: str, label: str | None,
+                   scale: float = 1.0) -> None:
+    median, low, high = (v * scale for v in values)
+    ax.errorbar([x], [median], yerr=[[median - low], [high - median]], fmt="o", color=color, ms=4, capsize=3,
+                label=label)
+
+
+def _table3_figure(frame: pd.DataFrame, figures: Figures) -> None:
+    """Table 3 as intervals: t̄ per cell, the time ratio, the σ ratio and the N1→N2 growth, ours (median and 95 %
+    bootstrap interval over the moves) beside the paper's."""
+    if frame.empty or "table3" not in set(frame["run_id"]):
         return
-    keys = [k for k in paper_table3() if k in mean]
-    fig, axes = plt.subplots(1, 2, figsize=(10, 3.6))
-    x = np.arange(len(keys))
-    labels = [f"{'dec' if m == 'decomposed' else 'full'} {c.replace('obstacle', 'obst')} N{1 if k == 10 else 2}"
-              for m, c, k in keys]
-    for ax, (title, values) in zip(axes, (("pipeline", {k: (mean[k] * 1e3, std[k] * 1e3) for k in keys}),
-                                          ("paper, Table 3 (i7-8550U, MATLAB)", paper_table3())), strict=True):
-        colors = ["C0" if k[0] == "decomposed" else "C1" for k in keys]
-        ax.bar(x, [values[k][0] for k in keys], yerr=[values[k][1] for k in keys], color=colors, capsize=3)
-        ax.set_xticks(x, labels, rotation=60, ha="right", fontsize=7)
-        ax.set_ylabel("OCP solve time t̄ ± σ [ms]")
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7))
+    cells = [(case, k) for case in CASE_LABELS for k in (10, 20)]
+    labels = [f"{case.replace('obstacle', 'obst')} N{1 if k == 10 else 2}" for case, k in cells]
+    x = np.arange(len(cells))
+    for offset, model, color in ((-0.12, "decomposed", "C0"), (0.12, "full", "C1")):
+        for i, (case, k) in enumerate(cells):
+            _with_interval(axes[0, 0], i + offset, _interval(frame, f"mean.{model}.{case}.k{k}"), color,
+                           model if i == 0 else None, 1e3)
+    axes[0, 0].set_ylabel("t̄ per OCP step [ms] (ours)")
+    axes[0, 0].set_title("(a) mean solve time, 95 % interval")
+    for ax, name, title in ((axes[0, 1], "ratio", "(b) t̄ decomposed / t̄ full"),
+                            (axes[1, 0], "sigma_ratio", "(c) σ decomposed / σ full")):
+        for i, (case, k) in enumerate(cells):
+            _with_interval(ax, i, _interval(frame, f"{name}.{case}.k{k}"), "C0", "ours" if i == 0 else None)
+            ax.plot(i, paper_value(SLUG, f"Tab3.{case}.N{1 if k == 10 else 2}.{name}"), "x", ms=7,
+                    **{k: v for k, v in PAPER_STYLE.items() if k == "color"}, label="paper" if i == 0 else None)
         ax.set_title(title)
+        ax.set_ylabel("ratio")
+    for ax in (axes[0, 0], axes[0, 1], axes[1, 0]):
+        ax.set_xticks(x, labels, rotation=30, ha="right", fontsize=7)
+        ax.legend(fontsize=7)
+    growth = [(model, case) for model in ("decomposed", "full") for case in CASE_LABELS]
+    for i, (model, case) in enumerate(growth):
+        _with_interval(axes[1, 1], i, _interval(frame, f"growth.{model}.{case}"), "C0" if model == "decomposed"
+                       else "C1", "ours" if i == 0 else None, 100)
+        short = "dec" if model == "decomposed" else "full"
+        axes[1, 1].plot(i, 100 * paper_value(SLUG, f"Tab3.{case}.growth.{short}"), "x", ms=7,
+                        color=PAPER_STYLE["color"], label="paper" if i == 0 else None)
+    axes[1, 1].set_xticks(range(len(growth)), [f"{m[:4]} {c.replace('obstacle', 'obst')}" for m, c in growth],
+                          rotation=30, ha="right", fontsize=7)
+    axes[1, 1].set_ylabel("t̄(N2) / t̄(N1) − 1 [%]")
+    axes[1, 1].set_title("(d) growth from N1 = 100 ms to N2 = 200 ms")
+    axes[1, 1].legend(fontsize=7)
+    moves = int(metric_value(frame, "table3", "moves"))
+    fig.suptitle(f"Table 3 over {moves} moves per cell (bootstrap over moves, 95 % intervals)")
     figures.save(fig, "table3-solve-times")
 
 

@@ -7,11 +7,13 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import yaml
 
 from analysis.core.compute_time import timing_metrics
 from analysis.core.errors import error_stats
 from analysis.core.targets import load_targets
 from pipeline.core.runlog import Run
+from pipeline.papers.nmpc_cdkd.kinematics import JOINTS, Arm, elbow_rotation
 
 XYZ = ("x", "y", "z")
 
@@ -29,6 +31,9 @@ CONTROL_HORIZON = 0.04             # s: 4 × 10 ms; solves longer than this dela
 
 
 TARGETS = Path(__file__).with_name("targets.csv")
+
+
+SLUG = "nmpc-cdkd"
 
 
 CASE_LABELS = {"no-obstacle": "without obstacles", "obstacle": "with obstacle",
@@ -50,6 +55,9 @@ def _xyz(frame: pd.DataFrame, field: str) -> np.ndarray:
 
 
 def _solve_metrics(solves: pd.DataFrame) -> dict[str, tuple[float, str]]:
+    """Statistics of the timed solves (a probe's warm-up solve is not timed)."""
+    if "timed" in solves:
+        solves = solves[solves["timed"].astype(bool)]
     s = solves["seconds"].to_numpy()
     values = {"solve.mean": (s.mean(), "s"), "solve.std": (s.std(), "s"), **timing_metrics("solve", s),
               "solve.samples": (len(s), "count"), "solve.iterations_mean": (solves["iterations"].mean(), "count"),
@@ -58,12 +66,6 @@ def _solve_metrics(solves: pd.DataFrame) -> dict[str, tuple[float, str]]:
               "solve.over_control_horizon": ((s > CONTROL_HORIZON).mean(), "fraction"),
               "solve.casadi_mean": (solves["solver_seconds"].mean(), "s")}
     return values
-
-
-def _combo(run_id: str) -> tuple[str, str, int]:
-    model, rest = run_id.split("__")[0].split("-", 1)
-    case, k = rest.rsplit("-k", 1)
-    return model, case, int(k)
 
 
 def _arrival(run: Run) -> float:
@@ -138,3 +140,27 @@ TRAJECTORY_COLUMNS = [  # (metric, column, factor from SI)
     ("clearance.mujoco_min", "min MuJoCo clearance [mm]", 1e3), ("wrist.z_max", "max wrist z [mm]", 1e3),
     ("wrist.xy_deviation_max", "max wrist xy deviation [mm]", 1e3), ("solve.mean", "t̄ solve [ms]", 1e3),
     ("solve.failures", "failed solves", 1.0), ("planning.median", "planning, median [ms]", 1e3)]
+
+
+def case_config(run: Run) -> dict:
+    """The config the run's case simulated (a case may change the experiment's, e.g. the rod length)."""
+    attached = run.attachments.get("case_config.yaml")
+    return yaml.safe_load(attached) if attached else run.config
+
+
+def orientation_lag_model(run: Run) -> dict[str, tuple[float, str]]:
+    """What eq. (13) itself implies for this move: near alignment ẽ ≈ (θ/2)·n, so q̇_o = J^T K ẽ turns the hand
+    at (K/2)·θ toward a desired orientation that {m} carries along at ω_m(t) (the elbow frame of the reference
+    joints): the lag settles at θ = 2 ω_m / K. At the lever d_f + d_e it moves the tool tip by 2 sin(θ/2)·lever."""
+    system = case_config(run)["system"]
+    arm = Arm.from_config(system)
+    ref = run["/reference"]
+    q_m = ref[[f"position.{j}" for j in JOINTS[:3]]].to_numpy()
+    t = ref.index.to_numpy()
+    R = elbow_rotation(arm, q_m)
+    spin = np.einsum("nji,njk->nik", R, np.gradient(R, t, axis=0))   # Rᵀ Ṙ = S(ω) in {m}
+    omega = np.linalg.norm(np.stack([spin[:, 2, 1], spin[:, 0, 2], spin[:, 1, 0]], axis=1), axis=1).max()
+    lag = 2 * omega / float(np.min(system["orientation"]["gain"]))
+    return {"lag_model.omega_max": (omega, "rad/s"), "lag_model.angle": (lag, "rad"),
+            "lag_model.orientation_max": (float(np.sin(lag / 2)), "1"),
+            "lag_model.tool_error_max": (float(2 * np.sin(lag / 2) * arm.safety_radius), "m")}

@@ -51,6 +51,8 @@ LIMITS = {
     "system.plant.physics_dt": Range(ge=1e-5, le=0.01), "system.scene.obstacles.names": Text(),
     "scenario.t1": Range(gt=0, le=30), "scenario.settle": Range(ge=0, le=10), "scenario.duration": Range(gt=0, le=30),
     "scenario.moves": Range(ge=1, le=1000), "scenario.tool_lengths": (Length(1, 5), NON_NEGATIVE),
+    "scenario.sampling": OneOf(("states", "closed-loop")), "scenario.samples_per_move": Range(ge=1, le=100),
+    "scenario.probe_inside": Range(ge=0, le=0.1), "scenario.probe_solves": Range(ge=1, le=20),
     "scenario.horizons": (Length(1, 5), Range(ge=2, le=200)),
     "system.nmpc.integrator": OneOf(("rk4", "euler")), "system.nmpc.warm_start": OneOf(("shift", "reference")),
     "system.nmpc.obstacle_prediction": OneOf(("constant_velocity", "frozen")),
@@ -91,11 +93,17 @@ RULES = (
          "system.nmpc.control_steps={0} exceeds the prediction horizon system.nmpc.horizon_steps={1}"),
 )
 _SOLVES = 2e5  # OCP solves of one experiment (a few ms each)
+
+
+def _solves_per_move(c) -> float:
+    """A two-OCP probe per sampled update, or every update of the closed loop (at most 2 T_min + t0 + settle)."""
+    if c.scenario.sampling == "states":
+        return c.scenario.probe_solves * c.scenario.samples_per_move
+    return (c.scenario.t0 + 2 * c.scenario.min_transition_time + c.scenario.settle) / c.system.dt
 BUDGETS = {
     "compute-time": Budget("OCP solves", lambda c: c.scenario.moves * len(c.scenario.models) * len(c.scenario.cases)
-                           * len(c.scenario.horizons) * (c.scenario.t0 + 2 * c.scenario.min_transition_time
-                                                         + c.scenario.settle) / c.system.dt, _SOLVES,
-                           "fewer scenario.moves"),
+                           * len(c.scenario.horizons) * _solves_per_move(c), _SOLVES,
+                           "fewer scenario.moves or scenario.samples_per_move"),
     **{name: Budget("OCP solves", lambda c: len(c.scenario.get("cases", [0])) * len(c.scenario.get("models", [0]))
                     * len(c.scenario.get("tool_lengths", [0])) * c.scenario.duration / c.system.dt, _SOLVES,
                     "a shorter scenario.duration or a longer system.dt")

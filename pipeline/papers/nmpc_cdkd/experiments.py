@@ -16,16 +16,17 @@ from pipeline.papers.nmpc_cdkd import planning
 from pipeline.papers.nmpc_cdkd.kinematics import JOINTS, Arm
 from pipeline.papers.nmpc_cdkd.nmpc import Nmpc, OcpSettings
 from pipeline.papers.nmpc_cdkd.plant import KinematicPlant, MujocoPlant, model_xml
-from pipeline.papers.nmpc_cdkd.simulation import Controller, Move, Obstacles, Trajectory, closed_loop, run
+from pipeline.papers.nmpc_cdkd.simulation import Controller, Move, Obstacles, Start, Trajectory, closed_loop, run
 
 XYZ = ["x", "y", "z"]
 OBSTACLE_RGBA = (0.85, 0.25, 0.2, 0.6)
 PLANNING_REPEATS = 20
 
 NmpcSolve = schemas.define(
-    "NmpcSolve", "One OCP solve of an NMPC: wall time, CasADi's own total, IPOPT iterations, status and cost.",
+    "NmpcSolve", "One OCP solve of an NMPC: wall time, CasADi's own total, IPOPT iterations, status and cost; "
+    "the move it belongs to and whether it is in the timing statistic (a probe's first solve is not).",
     model="string", seconds="double", solver_seconds="double", iterations="uint32", success="bool",
-    status="string", cost="double",
+    status="string", cost="double", move="uint32", timed="bool",
 )
 
 
@@ -45,14 +46,24 @@ def controller_of(cfg: DictConfig) -> Controller:
                       sample_dt=s.planning.sample_dt, wrist_band=s.planning.wrist_band)
 
 
+_SOLVERS: dict[tuple, Nmpc] = {}   # built NLPs by (settings, arm): the jobs of a sweep that a worker process
+#                                   runs one after another (Table 3's seeds) reuse them (~5 s for all twelve)
+
+
 def nmpc_of(cfg: DictConfig, arm: Arm, model: str, horizon_steps: int, obstacles: int, band: bool) -> Nmpc:
     s = cfg.system
-    return Nmpc(arm, OcpSettings(
+    settings = OcpSettings(
         model=model, horizon_steps=horizon_steps, dt=s.dt, mu=tuple(s.nmpc.mu), length_unit=s.nmpc.length_unit,
         acceleration=s.joint_limits.acceleration, jerk=s.joint_limits.jerk, obstacles=obstacles, height_band=band,
         integrator=s.nmpc.integrator, cost_quadrature=s.nmpc.cost_quadrature,
         orientation_lever=s.full.orientation_lever, tol=s.nmpc.tol,
-        acceptable_obj_change_tol=s.nmpc.acceptable_obj_change_tol, max_iter=s.nmpc.max_iter))
+        acceptable_obj_change_tol=s.nmpc.acceptable_obj_change_tol, max_iter=s.nmpc.max_iter)
+    key = (settings, b"".join(np.asarray(a, dtype=float).tobytes() for a in (
+        arm.dh.a, arm.dh.alpha, arm.dh.d, arm.dh.theta_offset, arm.wrist_dh.a, arm.wrist_dh.d, arm.base, arm.tool,
+        arm.lower, arm.upper, arm.velocity)))
+    if key not in _SOLVERS:
+        _SOLVERS[key] = Nmpc(arm, settings)
+    return _SOLVERS[key]
 
 
 def tool_pose(cfg: DictConfig, position) -> np.ndarray:
@@ -97,8 +108,9 @@ def _segment_clearance(wrist: np.ndarray, tip: np.ndarray, centres: np.ndarray, 
 
 
 def log_trajectory(log: RunWriter, arm: Arm, tr: Trajectory, model: str, obstacles: Obstacles,
-                   names: list[str], offset: float = 0.0) -> None:
-    """Write one closed-loop move; `offset` (s) places it after earlier moves of the same run."""
+                   names: list[str], offset: float = 0.0, move: int = 0, untimed: int = 0) -> None:
+    """Write one closed-loop move (or a probe of one); `offset` (s) places it after earlier ones of the same
+    run; the first `untimed` solves are left out of the timing statistic."""
     t = tr.t + offset
     efforts = {"effort": tr.effort} if np.isfinite(tr.effort).all() else {}  # a kinematic plant has none
     log.log_series("/joint_state", t, name=JOINTS, position=tr.q, velocity=tr.qd, **efforts)
@@ -114,14 +126,17 @@ def log_trajectory(log: RunWriter, arm: Arm, tr: Trajectory, model: str, obstacl
                        ("/tracking_error/orientation", tr.orientation_error)):
         log.log_series(topic, t, name=XYZ, error=err, norm=np.linalg.norm(err, axis=1))
     seconds = np.array([s.seconds for s in tr.solves])
-    log.log_series("/compute_time", tr.solve_t + offset, name=[model], calls=[1], seconds=seconds[:, None])
+    timed = np.arange(len(seconds)) >= untimed
+    log.log_series("/compute_time", tr.solve_t[timed] + offset, name=[model], calls=[1],
+                   seconds=seconds[timed, None])
     log.log_series("/nmpc/solve", tr.solve_t + offset, NmpcSolve, model=model, seconds=seconds,
                    solver_seconds=np.array([s.solver_seconds for s in tr.solves]),
                    iterations=np.array([s.iterations for s in tr.solves]),
                    success=np.array([s.success for s in tr.solves]),
-                   status=np.array([s.status for s in tr.solves]), cost=np.array([s.cost for s in tr.solves]))
+                   status=np.array([s.status for s in tr.solves]), cost=np.array([s.cost for s in tr.solves]),
+                   move=np.full(len(seconds), move), timed=timed)
     sel = tr.selection
-    log.log("/planning", offset, schemas.Scalars, name=["seconds", "margin", "candidates", "jump_free"],
+    log.log("/planning", float(t[0]), schemas.Scalars, name=["seconds", "margin", "candidates", "jump_free"],
             value=[tr.planning_seconds, sel.margin, sel.candidates, sel.jump_free])
     frames = [F[:, i] for i in range(1, 7)] + [F[:, 6] @ arm.tool]
     children = [f"link{i}" for i in range(1, 7)] + ["tool"]
@@ -239,27 +254,102 @@ def random_moves(cfg: DictConfig, arm: Arm) -> list[dict]:
     return moves
 
 
-def _moves_loop(cfg: DictConfig, arm: Arm, moves: list[dict], model: str, case: str, k: int):
-    """One (model, case, horizon) over all moves, pausing after every OCP solve; returns the trajectories."""
-    sc = cfg.scenario
+def _case_setup(cfg: DictConfig, m: dict, case: str) -> tuple[Obstacles, tuple[float, float] | None]:
+    """The obstacle and height band of a Table 3 case for move `m`."""
     with_obstacle, with_band = case != "no-obstacle", case == "obstacle-height"
-    nmpc = nmpc_of(cfg, arm, model, k, int(with_obstacle), with_band)
+    obstacles = (Obstacles(m["centre"][None], np.zeros((1, 3)), np.array([cfg.scenario.obstacle.radius]))
+                 if with_obstacle else Obstacles.none())
+    return obstacles, m["band"] if with_band else None
+
+
+def _move_of(cfg: DictConfig, m: dict, case: str) -> Move:
+    sc = cfg.scenario
+    obstacles, band = _case_setup(cfg, m, case)
+    return Move(m["T_start"], m["T_goal"], sc.t0, m["T"], sc.t0 + m["T"] + sc.settle, obstacles, band)
+
+
+def feasible_path(arm: Arm, q_ref: np.ndarray, obstacles: Obstacles, band: tuple[float, float] | None,
+                  inside: float) -> np.ndarray:
+    """(n, 6) joints that follow the reference γ but keep the wrist point `inside` (m) within the constraints of
+    a Table 3 case: the wrist height clipped into the band (10g), then pushed out of the obstacle's safety
+    sphere (10f): radially without a band; with one, up as far as the band allows, then horizontally; the tool
+    keeps the reference's orientation (IK branch of the reference). Where a closed loop would be when its
+    reference runs into a constraint, so the OCPs sampled on it meet their constraints active, as in the loop."""
+    wrist_ref = kin.wrist_point(arm, q_ref[:, :3])
+    wrist = wrist_ref.copy()
+    if band is not None:
+        wrist[:, 2] = np.clip(wrist[:, 2], band[0] + inside, band[1] - inside)
+    for centre, radius in zip(obstacles.centres, obstacles.radii + arm.safety_radius + inside, strict=True):
+        away = wrist - centre
+        if band is None:
+            distance = np.linalg.norm(away, axis=1)
+            push = distance < radius
+            wrist[push] = centre + away[push] * (radius / distance[push])[:, None]
+        else:
+            inside_sphere = np.linalg.norm(away, axis=1) < radius
+            top = band[1] - inside
+            wrist[inside_sphere, 2] = np.maximum(wrist[inside_sphere, 2], min(top, centre[2] + radius))
+            away = wrist - centre
+            horizontal = np.linalg.norm(away[:, :2], axis=1)
+            reach = np.sqrt(np.maximum(radius ** 2 - away[:, 2] ** 2, 0.0))
+            push = horizontal < reach
+            wrist[push, :2] = centre[:2] + away[push, :2] * (reach[push] / horizontal[push])[:, None]
+    q = q_ref.copy()
+    moved = np.flatnonzero(np.linalg.norm(wrist - wrist_ref, axis=1) > 0)
+    tool = kin.tool_pose(arm, q_ref[moved])
+    for i, T, p in zip(moved, tool, wrist[moved], strict=True):
+        T = T.copy()
+        T[:3, 3] += p - kin.wrist_target(arm, T)          # the same tool orientation, its wrist point at p
+        branches = kin.ik(arm, T)
+        gap = np.abs(kin.wrap(branches - q_ref[i])).max(axis=1)
+        if np.isfinite(gap).any():                          # else out of reach: the reference stays
+            q[i] = q_ref[i] + kin.wrap(branches[np.nanargmin(gap)] - q_ref[i])
+    return q
+
+
+def _probe_start(cfg: DictConfig, arm: Arm, m: dict, case: str, k: int, tick: int) -> Start:
+    """The state at robot update `tick` on the feasible path of move `m` (two updates before, k after)."""
+    sc, dt = cfg.scenario, cfg.system.dt
+    move = _move_of(cfg, m, case)
+    poly = planning.JointPolynomial(m["selection"].q_start, m["selection"].q_goal, sc.t0, m["T"])
+    ticks = np.arange(tick - 2, tick + k + 1)
+    path = feasible_path(arm, poly(np.maximum(ticks, 0) * dt), move.obstacles, move.band, sc.probe_inside)
+    rates = np.diff(path, axis=0) / dt                     # rates[i]: from update ticks[i] to ticks[i + 1]
+    return Start(tick=tick, q=path[2], u_prev=rates[[1, 0]], guess_q=path[2:], guess_u=rates[2:])
+
+
+def _moves_loop(cfg: DictConfig, arm: Arm, moves: list[dict], model: str, case: str, k: int):
+    """One (model, case, horizon) over all moves, pausing after every OCP solve; returns (move index,
+    trajectory, obstacles, untimed solves). `scenario.sampling=closed-loop`: every OCP of every move's closed
+    loop; `states`: at `scenario.samples_per_move` updates drawn along each move, the OCP the closed loop solves
+    there, timed after a probe of `scenario.probe_solves - 1` OCPs that starts that many control horizons
+    earlier on the feasible path (the first cold, guessed from that path; each next one from the previous
+    plan's prediction, guessed from its solution shifted, as in the loop)."""
+    sc = cfg.scenario
+    obstacles_of = lambda m: _case_setup(cfg, m, case)[0]  # noqa: E731
+    nmpc = nmpc_of(cfg, arm, model, k, int(case != "no-obstacle"), case == "obstacle-height")
+    ctl = controller_of(cfg)
     trajectories = []
-    for m in moves:
-        obstacles = (Obstacles(m["centre"][None], np.zeros((1, 3)), np.array([sc.obstacle.radius]))
-                     if with_obstacle else Obstacles.none())
-        move = Move(m["T_start"], m["T_goal"], sc.t0, m["T"], sc.t0 + m["T"] + sc.settle, obstacles,
-                    m["band"] if with_band else None)
-        tr = yield from closed_loop(arm, nmpc, controller_of(cfg), move, plant_factory(cfg, arm, obstacles, None),
-                                    m["selection"])
-        trajectories.append((tr, obstacles))
+    for index, m in enumerate(moves):
+        move, plant = _move_of(cfg, m, case), plant_factory(cfg, arm, obstacles_of(m), None)
+        if sc.sampling == "closed-loop":
+            tr = yield from closed_loop(arm, nmpc, ctl, move, plant, m["selection"])
+            trajectories.append((index, tr, move.obstacles, 0))
+            continue
+        for tick in m["ticks"]:   # the probe starts `probe_solves - 1` OCPs before the timed one
+            first = max(0, tick - (sc.probe_solves - 1) * ctl.control_steps)
+            start = _probe_start(cfg, arm, m, case, k, first)
+            solves = (tick - first) // ctl.control_steps + 1
+            tr = yield from closed_loop(arm, nmpc, ctl, move, plant, m["selection"], start, solves=solves)
+            trajectories.append((index, tr, move.obstacles, solves - 1))
     return trajectories
 
 
 def compute_time(cfg: DictConfig) -> list[Case]:
     """One run per (model, case, horizon). All of them are simulated together, on the first run's turn: the
     closed loops advance one OCP solve each in turn (like `time_interleaved`), so a change of load on a shared
-    machine falls on every combination alike and the ratios of Table 3 stay fair."""
+    machine falls on every combination alike and the ratios of Table 3 stay fair. Every combination sees the
+    same moves and, with `scenario.sampling=states`, the same sampled updates (a paired design)."""
     sc = cfg.scenario
     arm = arm_of(cfg)
     combos = [(model, case, k) for model in sc.models for case in sc.cases for k in sc.horizons]
@@ -267,6 +357,11 @@ def compute_time(cfg: DictConfig) -> list[Case]:
 
     def simulate_all() -> None:
         moves = random_moves(cfg, arm)
+        cs = cfg.system.nmpc.control_steps
+        for index, m in enumerate(moves):   # the OCP updates of the move's closed loop, sampled
+            updates = np.arange(0, round((sc.t0 + m["T"] + sc.settle) / cfg.system.dt) - cs, cs)
+            rng = np.random.default_rng([cfg.seed, index])
+            m["ticks"] = np.sort(rng.choice(updates, size=min(sc.samples_per_move, len(updates)), replace=False))
         active = {combo: _moves_loop(cfg, arm, moves, *combo) for combo in combos}
         while active:
             for combo, loop in list(active.items()):
@@ -279,9 +374,13 @@ def compute_time(cfg: DictConfig) -> list[Case]:
     def simulate(log: RunWriter, combo: tuple) -> None:
         if not results:
             simulate_all()
+        model, case, k = combo
+        dimensions = nmpc_of(cfg, arm, model, k, int(case != "no-obstacle"), case == "obstacle-height").dimensions()
+        log.log("/nmpc/problem", 0.0, schemas.Scalars, name=list(dimensions),
+                value=[float(v) for v in dimensions.values()])
         offset = 0.0
-        for tr, obstacles in results[combo]:
-            log_trajectory(log, arm, tr, combo[0], obstacles, ["obstacle"], offset)
-            offset += float(tr.t[-1]) + cfg.system.dt
+        for index, tr, obstacles, untimed in results[combo]:
+            log_trajectory(log, arm, tr, combo[0], obstacles, ["obstacle"], offset - float(tr.t[0]), index, untimed)
+            offset += float(tr.t[-1] - tr.t[0]) + cfg.system.dt
 
     return [Case(f"{model}-{case}-k{k}", lambda log, c=(model, case, k): simulate(log, c)) for model, case, k in combos]

@@ -112,7 +112,8 @@ def hand_jacobian(arm: Arm, q_o: np.ndarray) -> np.ndarray:
 # -- inverse kinematics (Sec. 2.1, eqs. 1-3) --------------------------------------------------------------
 
 
-def _wrap(x: np.ndarray) -> np.ndarray:
+def wrap(x: np.ndarray) -> np.ndarray:
+    """Angles into [−π, π)."""
     return np.remainder(np.asarray(x) + np.pi, 2 * np.pi) - np.pi
 
 
@@ -169,7 +170,7 @@ def ik(arm: Arm, T_e: np.ndarray) -> np.ndarray:
                     q6 = np.arctan2(sign * R[2, 1], -sign * R[2, 0])
                 else:  # wrist singular: only q4 + q6 is defined; put it all on q6
                     q4, q6 = 0.0, np.arctan2(R[1, 0], R[0, 0])
-                out[4 * shoulder + 2 * elbow + wrist] = _wrap(np.r_[q_m, q4, q5, q6])
+                out[4 * shoulder + 2 * elbow + wrist] = wrap(np.r_[q_m, q4, q5, q6])
     return out
 
 

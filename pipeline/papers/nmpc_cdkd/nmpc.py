@@ -148,6 +148,14 @@ class Nmpc:
         self._lbx = np.r_[lbx.ravel(), np.tile(-vel, k)]                              # (10a)
         self._ubx = np.r_[ubx.ravel(), np.tile(vel, k)]
 
+    def dimensions(self) -> dict[str, int]:
+        """Size of the NLP IPOPT solves: variables, constraints, nonzeros of the constraint Jacobian and of the
+        Lagrangian's Hessian (upper triangle)."""
+        solver = self._solver
+        return {"variables": solver.size1_in("x0"), "constraints": solver.size1_in("lbg"),
+                "jacobian_nonzeros": solver.get_function("nlp_jac_g").sparsity_out(1).nnz(),
+                "hessian_nonzeros": solver.get_function("nlp_hess_l").sparsity_out(0).nnz()}
+
     # -- NLP data from joint angles --------------------------------------------------------------------
     def state(self, q: np.ndarray) -> np.ndarray:
         """(..., nx): NLP state of joint vectors q (..., 6)."""

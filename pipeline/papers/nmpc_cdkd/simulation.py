@@ -65,6 +65,19 @@ class Controller:
     wrist_band: float                    # rad, undefined wrist flag near q5 = 0 (jump check)
 
 
+@dataclass(frozen=True)
+class Start:
+    """A closed loop that begins inside a move rather than at rest before it: at robot update `tick`, in joint
+    state `q` (ideal plant: measured = commanded), with the two inputs applied before and a guess for the first
+    OCP. Table 3's statistic is taken this way, on states sampled along the moves (experiments.py)."""
+
+    tick: int
+    q: np.ndarray            # (6,) rad
+    u_prev: np.ndarray       # (2, 6) rad/s: [u_{-1}, u_{-2}]
+    guess_q: np.ndarray      # (k+1, 6) rad: joints over the first OCP's horizon (nodes 0..k)
+    guess_u: np.ndarray      # (k, 6) rad/s
+
+
 @dataclass
 class Trajectory:
     """Everything one run logs, sampled every dt (index j = time j·dt) and per OCP solve."""
@@ -97,10 +110,12 @@ def _horizon_guess(nmpc: Nmpc, previous: Solution | None, shift: int, x_ref: np.
 
 
 def run(arm: Arm, nmpc: Nmpc, ctl: Controller, move: Move, make_plant,
-        selection: planning.Selection | None = None) -> Trajectory:
+        selection: planning.Selection | None = None, start: Start | None = None,
+        solves: int | None = None) -> Trajectory:
     """Plan the move (Sec. 3.1) unless `selection` is given, then run it in closed loop; `make_plant(q0)`
-    builds the plant at the start."""
-    loop = closed_loop(arm, nmpc, ctl, move, make_plant, selection)
+    builds the plant at the start. With `start`, the loop begins there; with `solves`, it ends after that
+    many OCPs."""
+    loop = closed_loop(arm, nmpc, ctl, move, make_plant, selection, start, solves)
     while True:
         try:
             next(loop)
@@ -109,80 +124,90 @@ def run(arm: Arm, nmpc: Nmpc, ctl: Controller, move: Move, make_plant,
 
 
 def closed_loop(arm: Arm, nmpc: Nmpc, ctl: Controller, move: Move, make_plant,
-                selection: planning.Selection | None = None) -> Generator[None, None, Trajectory]:
+                selection: planning.Selection | None = None, start: Start | None = None,
+                solves: int | None = None) -> Generator[None, None, Trajectory]:
     """`run` as a generator that pauses after every OCP solve, so several closed loops can be advanced in
-    turn (their solve times then see the same machine load) and returns the Trajectory."""
-    start = time.perf_counter()
+    turn (their solve times then see the same machine load) and returns the Trajectory (from `start.tick`
+    on, when a start is given)."""
+    t_start = time.perf_counter()
     sel = selection or planning.select_configuration(arm, move.T_start, move.T_goal,
                                                      round(move.T / ctl.sample_dt) + 1, ctl.wrist_band)
     poly = planning.JointPolynomial(sel.q_start, sel.q_goal, move.t0, move.T)
-    planning_seconds = time.perf_counter() - start if selection is None else float("nan")
+    planning_seconds = time.perf_counter() - t_start if selection is None else float("nan")
     dt, k, cs = ctl.dt, nmpc.s.horizon_steps, ctl.control_steps
-    n = round(move.duration / dt)
-    t_all = np.arange(n + k + 1) * dt                       # the horizon looks k steps past the end
+    total = round(move.duration / dt)
+    t_all = np.arange(total + k + 1) * dt                   # the horizon looks k steps past the end
     q_ref_all, qd_ref_all = poly(t_all), poly(t_all, 1)
     decomposed = nmpc.s.model == "decomposed"
     joints = slice(0, nmpc.nu)
     R_des = kin.tool_pose(arm, q_ref_all)[:, :3, :3] @ arm.tool[:3, :3].T   # R_w^f of the reference
 
-    plant = make_plant(sel.q_start)
-    t = t_all[:n + 1]
+    first = start.tick if start is not None else 0
+    last = total if solves is None else min(total, first + solves * cs)
+    n = last - first                                        # local index i is robot update first + i
+    plant = make_plant(start.q if start is not None else sel.q_start)
+    t = t_all[first:last + 1]
     q, qd, effort = np.empty((n + 1, 6)), np.empty((n + 1, 6)), np.empty((n + 1, 6))
     q_cmd, qd_cmd = np.empty((n + 1, 6)), np.zeros((n + 1, 6))
     e_o = np.zeros((n + 1, 3))
     nu_obs = len(move.obstacles)
     centres = move.obstacles.at(t)
     tool_distance = np.empty((n + 1, nu_obs)) if plant.kind == "mujoco" and nu_obs else None
-    cmd = sel.q_start.copy()
-    u_applied = np.zeros((2, nmpc.nu))                      # [u_{-1}, u_{-2}]
-    solves, solve_t = [], []
+    cmd = (start.q if start is not None else sel.q_start).copy()
+    u_applied = np.zeros((2, nmpc.nu)) if start is None else start.u_prev[:, joints].copy()   # [u_{-1}, u_{-2}]
+    solved, solve_t = [], []
     plan: Solution | None = None
     plan_start = 0
-    last: Solution | None = None
+    last_solution: Solution | None = None
     radii = move.obstacles.radii + arm.safety_radius
-    for j in range(n + 1):
-        q[j], qd[j], effort[j] = plant.q, plant.qd, plant.effort
+    for i in range(n + 1):
+        j = first + i
+        q[i], qd[i], effort[i] = plant.q, plant.qd, plant.effort
         if tool_distance is not None:
-            tool_distance[j] = plant.tool_distances()
-        q_cmd[j] = cmd
-        if j == n:
+            tool_distance[i] = plant.tool_distances()
+        q_cmd[i] = cmd
+        if i == n:
             break
-        if j % cs == 0:                                     # a new OCP every control horizon
+        if i % cs == 0:                                     # a new OCP every control horizon
             nodes = t_all[j + 1:j + k + 1]
-            x0 = nmpc.state(cmd if ctl.initial_state == "command" else q[j])
+            x0 = nmpc.state(cmd if ctl.initial_state == "command" else q[i])
             ref = nmpc.reference(q_ref_all[j + 1:j + k + 1], quat_sign_of=None if decomposed else x0[3:7])
-            guess = _horizon_guess(nmpc, last, cs, nmpc.state(q_ref_all[j:j + k + 1]),
-                                   qd_ref_all[j:j + k, joints], ctl.warm_start)
-            obstacle_t = nodes if ctl.obstacle_prediction == "constant_velocity" else np.full(k, t[j])
+            if start is not None and last_solution is None:
+                guess = nmpc.state(start.guess_q), start.guess_u[:, joints]
+            else:
+                guess = _horizon_guess(nmpc, last_solution, cs, nmpc.state(q_ref_all[j:j + k + 1]),
+                                       qd_ref_all[j:j + k, joints], ctl.warm_start)
+            obstacle_t = nodes if ctl.obstacle_prediction == "constant_velocity" else np.full(k, t_all[j])
             sol = nmpc.solve(x0, ref, u_applied, *guess, centres=move.obstacles.at(obstacle_t), radii=radii,
                              band=move.band)
-            solves.append(sol)
-            solve_t.append(t[j])
-            last = sol
+            solved.append(sol)
+            solve_t.append(t_all[j])
+            last_solution = sol
             if sol.success or ctl.on_failure == "solver_iterate":
-                plan, plan_start = sol, j
+                plan, plan_start = sol, i
             yield
-        offset = j - plan_start
+        offset = i - plan_start
         u = plan.u[offset] if plan is not None and offset < k else np.zeros(nmpc.nu)
         u_applied = np.stack([u, u_applied[0]])
-        qd_cmd[j, joints] = u
+        qd_cmd[i, joints] = u
         cmd[joints] += u * dt
         if decomposed:                                      # Sec. 3.3, eqs. (3), (11), (13)
-            q_m = cmd[:3] if ctl.desired_from == "command" else q[j, :3]
+            q_m = cmd[:3] if ctl.desired_from == "command" else q[i, :3]
             desired = kin.quaternion(kin.elbow_rotation(arm, q_m).T @ R_des[j + 1])
-            current = kin.quaternion(kin.hand_rotation(arm, q[j, 3:]))
-            e_o[j] = kin.orientation_error(desired, current)
-            qd_o = kin.hand_jacobian(arm, q[j, 3:]).T @ (ctl.gain * e_o[j])
+            current = kin.quaternion(kin.hand_rotation(arm, q[i, 3:]))
+            e_o[i] = kin.orientation_error(desired, current)
+            qd_o = kin.hand_jacobian(arm, q[i, 3:]).T @ (ctl.gain * e_o[i])
             cmd[3:] = np.clip(cmd[3:] + qd_o * dt, arm.lower[3:], arm.upper[3:])
-            qd_cmd[j, 3:] = qd_o
+            qd_cmd[i, 3:] = qd_o
         else:
-            current = kin.quaternion(kin.tool_pose(arm, q[j])[:3, :3])
-            e_o[j] = kin.orientation_error(kin.quaternion(R_des[j] @ arm.tool[:3, :3]), current)
-        plant.step(cmd, qd_cmd[j], centres[j + 1])
+            current = kin.quaternion(kin.tool_pose(arm, q[i])[:3, :3])
+            e_o[i] = kin.orientation_error(kin.quaternion(R_des[j] @ arm.tool[:3, :3]), current)
+        plant.step(cmd, qd_cmd[i], centres[i + 1])
         if not np.isfinite(plant.q).all():
-            raise SimulationFailed(f"joint state not finite at t = {t[j + 1]:.3f} s")
+            raise SimulationFailed(f"joint state not finite at t = {t[i + 1]:.3f} s")
     e_o[n] = e_o[n - 1]
     plant.check(t, np.concatenate([q, qd], axis=1))
-    return Trajectory(t=t, q=q, qd=qd, effort=effort, q_cmd=q_cmd, qd_cmd=qd_cmd, q_ref=q_ref_all[:n + 1],
-                      qd_ref=qd_ref_all[:n + 1], orientation_error=e_o, centres=centres, tool_distance=tool_distance,
-                      solve_t=np.asarray(solve_t), solves=solves, selection=sel, planning_seconds=planning_seconds)
+    return Trajectory(t=t, q=q, qd=qd, effort=effort, q_cmd=q_cmd, qd_cmd=qd_cmd, q_ref=q_ref_all[first:last + 1],
+                      qd_ref=qd_ref_all[first:last + 1], orientation_error=e_o, centres=centres,
+                      tool_distance=tool_distance, solve_t=np.asarray(solve_t), solves=solved, selection=sel,
+                      planning_seconds=planning_seconds)

@@ -50,8 +50,10 @@ class Arm:
         moment = gravity_moment(g.lG3, g.lG4, g.l3, masses)
         theta3p = (np.deg2rad(system.spring.theta3p_deg) if system.spring.theta3p_deg is not None
                    else balanced_theta3p(moment, system.gravity, system.spring.k3))
+        scale = float(system.get("inertia_scale", 1.0))
         return cls(l1=g.l1, l2=g.l2, l3=g.l3, l4=g.l4, lG1=g.lG1, lG3=g.lG3, lG4=g.lG4, h=g.h, masses=masses,
-                   inertia=tuple(tuple(float(v) for v in row) for row in system.inertia), gravity=system.gravity,
+                   inertia=tuple(tuple(scale * float(v) for v in row) for row in system.inertia),
+                   gravity=system.gravity,
                    k3=system.spring.k3, theta3p=float(theta3p))
 
     @property

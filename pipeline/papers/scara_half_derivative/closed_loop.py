@@ -18,7 +18,15 @@ from pipeline.papers.scara_half_derivative.arm import Arm
 from pipeline.papers.scara_half_derivative.controller import CartesianController
 from pipeline.papers.scara_half_derivative.setpoint import Motion
 
-DIVERGED_ERROR = 0.5   # m: a Cartesian error this large means the loop is unstable, not tracking
+DIVERGED_ERROR = 0.5   # m and rad: an error of x, y, z or θ this large means the loop is unstable, not tracking
+
+
+def divergence(error: np.ndarray, t: float) -> str | None:
+    """Why a tracking error (x, y, z, θ) means the loop diverged, or None (NaN diverges too)."""
+    worst = int(np.argmax(np.where(np.isfinite(error), np.abs(error), np.inf)))
+    if np.abs(error[worst]) < DIVERGED_ERROR:
+        return None
+    return f"unstable: {'xyzθ'[worst]} error {abs(error[worst]):.3g} {'rad' if worst == 3 else 'm'} at t = {t:.4g} s"
 
 
 class Plant(Protocol):
@@ -63,6 +71,8 @@ class ClosedLoopRun:
     q: np.ndarray             # (N, 4)
     qd: np.ndarray            # (N, 4)
     loop_residual: np.ndarray | None = None   # (K,) Exudyn's loop-closure gap at each control instant
+    tau_fine: np.ndarray | None = None        # (N−1, 4) torques over each integration step, when they are
+                                              # not held over the period (the `continuous` implementation)
 
 
 def run_closed_loop(plant: Plant, controller: CartesianController, motion: Motion, duration: float,
@@ -80,9 +90,9 @@ def run_closed_loop(plant: Plant, controller: CartesianController, motion: Motio
         start = clock()
         tau[k] = controller(q, qd, x_d[k], xd_d[k])
         wall[k] = clock() - start
-        error = np.abs(controller.error[:3]).max()
-        if not (error < DIVERGED_ERROR and np.isfinite(tau[k]).all()):   # NaN fails the comparison too
-            raise SimulationFailed(f"unstable: Cartesian error {error:.3g} m at t = {t_control[k]:.4g} s")
+        why = divergence(controller.error, t_control[k])
+        if why or not np.isfinite(tau[k]).all():
+            raise SimulationFailed(why or f"unstable: non-finite torque at t = {t_control[k]:.4g} s")
         if residual is not None:
             residual[k] = residual_of()
         plant.advance(tau[k])

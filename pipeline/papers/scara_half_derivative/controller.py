@@ -6,7 +6,9 @@
     e^(1/2)(kT_s) = T_s^(−1/2) Σ_{j=0..n} w_j e((k−j)T_s)                                 (15), (16)
 
 K, D, HD are diagonal: [k_xyz, k_xyz, k_xyz, k_θ] and alike. KD is the same law without the half-derivative
-term: its controller skips the filter altogether (so its compute time is KD's own).
+term: its controller skips the filter altogether (so its compute time is KD's own). With `difference=True`
+the first derivative is the backward difference of the sampled errors, ė_k = (e_k − e_{k−1})/T_s, instead of
+ẋ_d − J(θ)θ̇ (the `sampled-difference` implementation of batch.py).
 """
 
 from __future__ import annotations
@@ -53,8 +55,9 @@ class Gains:
 class CartesianController:
     """One instance per run: it keeps the error history of the half-derivative filter."""
 
-    def __init__(self, arm: Arm, gains: Gains, period: float, gl_terms: int, compensate_stiffness: bool = True):
-        self.arm, self.gains = arm, gains
+    def __init__(self, arm: Arm, gains: Gains, period: float, gl_terms: int, compensate_stiffness: bool = True,
+                 difference: bool = False):
+        self.arm, self.gains, self.period, self.difference = arm, gains, period, difference
         self.D, self.HD = gains.D, gains.HD
         self.filter = GrunwaldLetnikov(HALF, gl_terms, period, width=4) if gains.fractional else None
         compensation = gl_dc_gain(HALF, gl_terms, period) if (gains.fractional and compensate_stiffness) else 0.0
@@ -66,8 +69,9 @@ class CartesianController:
         """Joint torques for the sampled state (θ, θ̇) and the set-point (x_d, ẋ_d) of this period."""
         x, J = fk_jacobian(self.arm, q)
         e = x_d - x
+        rate = (e - self.error) / self.period if self.difference else xd_d - J @ qd
         self.error = e
-        force = self.K * e + self.D * (xd_d - J @ qd)
+        force = self.K * e + self.D * rate
         if self.filter is not None:
             force += self.HD * self.filter.push(e)
         tau = J.T @ force

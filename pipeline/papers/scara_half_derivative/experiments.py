@@ -1,20 +1,43 @@
 """Simulate stage of `scara-half-derivative`: the set-point motion (Figs. 4-5), Table 2 with Figs. 8-10
-(KD, KDHD, KHD on the Exudyn closed chain), the ICE/ISE maps of Fig. 6 (one run per grid point, swept with
-Hydra `-m`) and the equal-ICE path of Fig. 7. Every closed-loop run logs what the analysis needs."""
+(KD, KDHD, KHD on the Exudyn closed chain), the ICE/ISE maps of Fig. 6 (one run per grid point) and the
+equal-ICE path of Fig. 7. On the reduced plant the runs of an experiment are simulated together (batch.py);
+the sensitivity experiments are the same cases swept (Hydra `-m`) over what the paper does not give. Every
+closed-loop run logs what the analysis needs."""
 
 from __future__ import annotations
 
 import numpy as np
 import yaml
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig, ListConfig, OmegaConf
 
 from pipeline.core import schemas
 from pipeline.core.experiment import Case
-from pipeline.core.runlog import RunWriter
+from pipeline.core.runlog import RunWriter, SimulationFailed
+from pipeline.papers.scara_half_derivative import batch
 from pipeline.papers.scara_half_derivative.arm import EXTERNAL, JOINTS, LINKS, Arm, fk, ik, jacobian, link_frames
 from pipeline.papers.scara_half_derivative.closed_loop import ClosedLoopRun, PlantSettings, make_plant, run_closed_loop
 from pipeline.papers.scara_half_derivative.controller import CartesianController, Gains
 from pipeline.papers.scara_half_derivative.setpoint import Motion
+
+Indexes = schemas.define(
+    "ClosedLoopIndexes", "Table 2's indexes and eqs. (18)-(19) of one closed-loop run over [0, T_sim], on every "
+    "integration step: max and mean |e| of x, y, z in that order (m), ISE = ∫(e_x² + e_y² + e_z²) dt "
+    "(trapezoid, m²s), ICE = Σ_i ∫τ_i² dt of the applied torques (N²m²s), max |τ_i| of joints 1-4 (N m).",
+    e_max_m="double[]", e_mean_m="double[]", ise_m2s="double", ice_N2m2s="double", tau_max_Nm="double[]",
+)
+
+
+def indexes(arm: Arm, motion: Motion, run: ClosedLoopRun, period: float) -> dict:
+    """The fields of `Indexes` from the run's integration steps: the analysis reads these instead of decoding
+    every logged sample (a map sweep has hundreds of runs)."""
+    e = motion(run.t)[0][:, :3] - fk(arm, run.q)[:, :3]
+    if run.tau_fine is None:
+        tau, step = run.tau, period
+    else:
+        tau, step = run.tau_fine, float(run.t[1] - run.t[0])
+    return {"e_max_m": np.abs(e).max(axis=0).tolist(),
+            "e_mean_m": np.abs(e).mean(axis=0).tolist(), "ise_m2s": float(np.trapezoid((e ** 2).sum(axis=1), run.t)),
+            "ice_N2m2s": float((tau ** 2).sum() * step), "tau_max_Nm": np.abs(tau).max(axis=0).tolist()}
 
 
 def arm_of(cfg: DictConfig) -> Arm:
@@ -62,22 +85,30 @@ def _stride(log_dt: float, dt: float, what: str) -> int:
 
 
 def log_closed_loop(log: RunWriter, cfg: DictConfig, arm: Arm, motion: Motion, run: ClosedLoopRun, law: str) -> None:
-    """Fine-step signals every `execute.log_dt`, torques and controller times every control period, link
-    frames every `execute.tf_dt`, and Exudyn's loop-closure gap."""
+    """Fine-step signals every `execute.log_dt`, the torques (held over each control period, or at every
+    integration step when they vary within it; every `execute.log_dt` when that is longer), controller times,
+    link frames every `execute.tf_dt`, and Exudyn's loop-closure gap."""
     ex = cfg.execute
     dt = float(run.t[1] - run.t[0])
     fine = slice(None, None, _stride(ex.log_dt, dt, "execute.log_dt"))
     t, q, qd = run.t[fine], run.q[fine], run.qd[fine]
     x_d, xd_d, xdd_d = motion(t)
-    period = cfg.system.control.dt
-    held = run.tau[np.minimum((t / period + 1e-9).astype(int), len(run.tau) - 1)]
+    if run.tau_fine is None:
+        t_tau, tau = run.t_control, run.tau
+    else:
+        t_tau, tau = run.t[:-1], run.tau_fine
+    step = float(t_tau[1] - t_tau[0]) if len(t_tau) > 1 else dt
+    held = tau[np.minimum((t / step + 1e-9).astype(int), len(tau) - 1)]
+    command = slice(None, None, max(1, round(ex.log_dt / step)))   # a sweep's runs are logged to look at
     error = x_d - fk(arm, q)
     log.log_series("/reference", t, name=list(EXTERNAL), position=x_d, velocity=xd_d, acceleration=xdd_d)
     log.log_series("/joint_state", t, name=list(JOINTS), position=q, velocity=qd, effort=held)
     log.log_series("/tracking_error", t, name=list(EXTERNAL), error=error,
                    norm=np.linalg.norm(error[:, :3], axis=1))
-    log.log_series("/command", run.t_control, kind="torque", name=list(JOINTS), value=run.tau)
-    log.log_series("/compute_time", run.t_control, name=[law], seconds=run.controller_s[:, None], calls=[1])
+    log.log_series("/command", t_tau[command], kind="torque", name=list(JOINTS), value=tau[command])
+    log.log("/closed_loop/indexes", float(run.t[-1]), Indexes, **indexes(arm, motion, run, cfg.system.control.dt))
+    if np.isfinite(run.controller_s).all():   # a batch times no single controller
+        log.log_series("/compute_time", run.t_control, name=[law], seconds=run.controller_s[:, None], calls=[1])
     if run.loop_residual is not None:
         log.log_series("/loop_closure", run.t_control, schemas.Scalars, name=["gap"],
                        value=run.loop_residual[:, None])
@@ -86,8 +117,17 @@ def log_closed_loop(log: RunWriter, cfg: DictConfig, arm: Arm, motion: Motion, r
                        _frames_with_end_effector(arm, run.q[tf], motion(run.t[tf])[0]))
 
 
+def _model_yaml(cfg: DictConfig, arm: Arm, law: str, g: Gains) -> str:
+    control, ex = cfg.system.control, cfg.execute
+    plant = {"kind": ex.plant, "dt": ex.dt, "spectral_radius": ex.spectral_radius,
+             "newton_tolerance": ex.newton_tolerance}
+    model = {"arm": {k: _plain(v) for k, v in vars(arm).items()}, "gains": vars(g), "law": law, "plant": plant,
+             "control": OmegaConf.to_container(control, resolve=True)}
+    return yaml.safe_dump(model, sort_keys=False)
+
+
 def simulate_tuning(log: RunWriter, cfg: DictConfig, k_xyz: float, d_xyz: float, hd_xyz: float) -> None:
-    """One closed-loop run of the set-point motion with the tuning (k_xyz, d_xyz, hd_xyz)."""
+    """One closed-loop run of the set-point motion with the tuning (k_xyz, d_xyz, hd_xyz), alone."""
     arm = arm_of(cfg)
     motion = motion_of(cfg, arm)
     control, ex = cfg.system.control, cfg.execute
@@ -95,13 +135,41 @@ def simulate_tuning(log: RunWriter, cfg: DictConfig, k_xyz: float, d_xyz: float,
     plant_settings = PlantSettings(kind=ex.plant, dt=ex.dt, spectral_radius=ex.spectral_radius,
                                    newton_tolerance=ex.newton_tolerance)
     periods = round(cfg.scenario.duration / control.dt)
-    model = {"arm": {k: _plain(v) for k, v in vars(arm).items()}, "gains": vars(g), "law": law,
-             "plant": vars(plant_settings), "control": OmegaConf.to_container(control, resolve=True)}
-    log.attach("model.yaml", yaml.safe_dump(model, sort_keys=False), "application/yaml")
+    log.attach("model.yaml", _model_yaml(cfg, arm, law, g), "application/yaml")
     plant = make_plant(plant_settings, arm, home(cfg), np.zeros(4), control.dt, periods)
-    controller = CartesianController(arm, g, control.dt, control.gl_terms, control.compensate_stiffness)
+    controller = CartesianController(arm, g, control.dt, control.gl_terms, control.compensate_stiffness,
+                                     difference=control.implementation == "sampled-difference")
     run = run_closed_loop(plant, controller, motion, cfg.scenario.duration, control.dt)
     log_closed_loop(log, cfg, arm, motion, run, law)
+
+
+def tuning_cases(cfg: DictConfig, tunings: list[tuple[str, float, float, float]]) -> list[Case]:
+    """One case per (case id, k_xyz, d_xyz, hd_xyz). On the reduced plant all of them are simulated together
+    on the first case's turn (batch.py); on Exudyn each case runs alone when its turn comes."""
+    if cfg.execute.plant != "lagrange":
+        return [Case(cid, lambda log, t=(k, d, hd): simulate_tuning(log, cfg, *t)) for cid, k, d, hd in tunings]
+    results: dict[str, tuple] = {}
+
+    def simulate_all() -> None:
+        arm = arm_of(cfg)
+        control = cfg.system.control
+        laws = [gains(cfg, k, d, hd) for _, k, d, hd in tunings]
+        out = batch.simulate(arm, [g for _, g in laws], motion_of(cfg, arm), home(cfg), cfg.scenario.duration,
+                             control.dt, round(control.dt / cfg.execute.dt), control.gl_terms,
+                             control.implementation, control.compensate_stiffness)
+        for (cid, *_), (law, g), run, failure in zip(tunings, laws, out.runs, out.failures, strict=True):
+            results[cid] = (arm, law, g, run, failure)
+
+    def simulate(log: RunWriter, cid: str) -> None:
+        if not results:
+            simulate_all()
+        arm, law, g, run, failure = results.pop(cid)
+        log.attach("model.yaml", _model_yaml(cfg, arm, law, g), "application/yaml")
+        if failure:
+            raise SimulationFailed(failure)
+        log_closed_loop(log, cfg, arm, motion_of(cfg, arm), run, law)
+
+    return [Case(cid, lambda log, c=cid: simulate(log, c)) for cid, *_ in tunings]
 
 
 # -- E1: the set-point motion, Figs. 4-5 ------------------------------------------------------------------
@@ -130,18 +198,18 @@ def setpoint(cfg: DictConfig) -> list[Case]:
 
 def table2(cfg: DictConfig) -> list[Case]:
     sc = cfg.scenario
-    return [Case(f"{name}-k{k:g}", lambda log, k=float(k), t=sc.tunings[name]:
-                 simulate_tuning(log, cfg, k, float(t.d_xyz), float(t.hd_xyz)))
-            for k in sc.k_xyz for name in sc.controllers]
+    return tuning_cases(cfg, [(f"{name}-k{k:g}", float(k), float(sc.tunings[name].d_xyz),
+                               float(sc.tunings[name].hd_xyz)) for k in sc.k_xyz for name in sc.controllers])
 
 
-# -- E3: one grid point of the Fig. 6 maps (sweep with -m) --------------------------------------------------
+# -- E3: the Fig. 6 maps, one run per grid point ------------------------------------------------------------
 
 
 def maps(cfg: DictConfig) -> list[Case]:
     sc = cfg.scenario
-    k, d, hd = float(sc.k_xyz), float(sc.d_xyz), float(sc.hd_xyz)
-    return [Case(f"k{k:g}-d{d:g}-hd{hd:g}", lambda log: simulate_tuning(log, cfg, k, d, hd))]
+    stiffnesses = sc.k_xyz if isinstance(sc.k_xyz, ListConfig) else [sc.k_xyz]
+    return tuning_cases(cfg, [(f"k{k:g}-d{d:g}-hd{hd:g}", float(k), float(d), float(hd))
+                              for k in stiffnesses for hd in sc.hd_xyz for d in sc.d_xyz])
 
 
 # -- E4: along the equal-ICE line, Fig. 7 -------------------------------------------------------------------
@@ -150,6 +218,6 @@ def maps(cfg: DictConfig) -> list[Case]:
 def locus(cfg: DictConfig) -> list[Case]:
     sc = cfg.scenario
     line = sc.line
-    return [Case(f"k{k:g}-d{d:g}", lambda log, k=float(k), d=float(d):
-                 simulate_tuning(log, cfg, k, d, max(0.0, round(line.intercept + line.slope * d, 6))))   # eq. (20)
-            for k in sc.k_xyz for d in sc.d_xyz]
+    return tuning_cases(cfg, [(f"k{k:g}-d{d:g}", float(k), float(d),
+                               max(0.0, round(line.intercept + line.slope * d, 6)))   # eq. (20)
+                              for k in sc.k_xyz for d in sc.d_xyz])
