@@ -30,6 +30,8 @@ def main() -> None:
         except BadInput as err:
             print(f"error: {err}", file=sys.stderr)
             sys.exit(2)
+    if _timed_sweep_on_this_machine(flags, overrides):  # its jobs one after another: no timing shares a core
+        sys.argv.append("hydra.launcher.n_jobs=1")
 
     import hydra
     from hydra.core.hydra_config import HydraConfig
@@ -79,6 +81,15 @@ def main() -> None:
                       stages.argument(overrides, "experiment"), code if isinstance(code, int) else 1,
                       sweep="-m" in flags or "--multirun" in flags)
     sys.exit(code)
+
+
+def _timed_sweep_on_this_machine(flags: list[str], overrides: list[str]) -> bool:
+    from pipeline.core import stages
+    from pipeline.core.experiment import resolve
+
+    experiment = stages.argument(overrides, "experiment")
+    local = stages.argument(overrides, "hydra/launcher") in (None, "local", "joblib")
+    return bool({"-m", "--multirun"} & set(flags)) and local and experiment is not None and resolve(experiment).timed
 
 
 if __name__ == "__main__":

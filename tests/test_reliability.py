@@ -183,11 +183,13 @@ def test_runs_in_parallel_processes_equal_runs_in_one(tmp_path):
 
 
 def test_a_timed_experiment_runs_its_cases_alone(tmp_path):
-    proc = run_cli("pipeline", "experiment=curve-discretization/timing-fig3", "scenario.joint_counts.last=8",
-                   "scenario.repeats=3", "scenario.warmup=1", f"data_dir={tmp_path}", "workers=2", "progress=false")
+    """Its runs one after another, also as a sweep (whose local launcher would otherwise run one job per core)."""
+    proc = run_cli("pipeline", "-m", "experiment=curve-discretization/timing-fig3", "scenario.joint_counts.last=6",
+                   "scenario.repeats=2", "scenario.warmup=1", "seed=0,1", f"data_dir={tmp_path}", "progress=false")
     assert proc.returncode == 0, proc.stderr
+    assert "n_jobs=1" in proc.stdout + proc.stderr
     paths = run_files(tmp_path / "runs/curve-discretization/timing-fig3")
-    assert len(paths) > 1 and {read_run(p).metadata["parallel_runs"] for p in paths} == {"1"}
+    assert len(paths) == 4 and {read_run(p).metadata["parallel_runs"] for p in paths} == {"1"}
 
 
 def test_temporary_names_are_unique_and_publishing_is_all_or_nothing(tmp_path):
