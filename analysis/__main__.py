@@ -91,9 +91,9 @@ def main() -> None:
         code = interrupts.exit_code(err)
     except SystemExit as exit_:
         code = exit_.code
-    if not runs_nothing(flags):
+    if code == 0 and not runs_nothing(flags):
         stages.record(stages.argument(overrides, "data_dir", "data"), stages.argument(overrides, "stage", "all"),
-                      stages.argument(overrides, "experiment"), code if isinstance(code, int) else 1)
+                      stages.argument(overrides, "experiment"))
     sys.exit(code)
 
 

@@ -76,10 +76,9 @@ def main() -> None:
         code = interrupts.exit_code(err)
     except SystemExit as exit_:
         code = exit_.code
-    if not runs_nothing(flags):
+    if code == 0 and not runs_nothing(flags):
         stages.record(stages.argument(overrides, "data_dir", "data"), "simulate",
-                      stages.argument(overrides, "experiment"), code if isinstance(code, int) else 1,
-                      sweep="-m" in flags or "--multirun" in flags)
+                      stages.argument(overrides, "experiment"), sweep="-m" in flags or "--multirun" in flags)
     sys.exit(code)
 
 

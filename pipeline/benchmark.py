@@ -39,7 +39,7 @@ def stage_times(data_dir: Path) -> int:
         print(f"error: no stage has run under {data_dir} (run the pipeline: python -m dvc repro)", file=sys.stderr)
         return 2
     table = pd.DataFrame(entries).reindex(columns=["stage", "experiment", "wall_s", "cpu_s", "children_cpu_s",
-                                                   "first_step_s", "first_step_cpu_s", "exit_code"])
+                                                   "first_step_s", "first_step_cpu_s"])
     table["cpu_s"] = table["cpu_s"] + table["children_cpu_s"].fillna(0)  # a stage's workers count too
     table = table.drop(columns="children_cpu_s")
     m = provenance.machine()

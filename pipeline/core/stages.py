@@ -1,6 +1,6 @@
 """How long each stage process took, so the slowest stages of a pipeline run are visible.
 
-Every `python -m pipeline` and `python -m analysis` process appends one JSON line to
+Every `python -m pipeline` and `python -m analysis` process that succeeds appends one JSON line to
 `<data_dir>/.stages.jsonl` when it ends: what it ran, its wall and CPU time, and (simulate) how long it took
 from process start to the first simulated step. Lines are short and appended in one write, so processes
 running at once do not interleave them. `python -m pipeline.benchmark stages` prints the newest line of each
@@ -48,13 +48,13 @@ def argument(overrides: list[str], key: str, default: str | None = None) -> str 
     return default
 
 
-def record(data_dir: str | Path, stage: str, experiment: str | None, exit_code: int, **extra: Any) -> None:
-    """Append this process's line to the journal (a missing data_dir means nothing ran: nothing to record)."""
+def record(data_dir: str | Path, stage: str, experiment: str | None, **extra: Any) -> None:
+    """Append this process's line to the journal."""
     data_dir = Path(data_dir)
     if not data_dir.is_dir():
         return
     cpu = os.times()
-    line = json.dumps({"stage": stage, "experiment": experiment, "exit_code": exit_code,
+    line = json.dumps({"stage": stage, "experiment": experiment,
                        "wall_s": round(process_age(), 3), "cpu_s": round(cpu.user + cpu.system, 3),
                        "children_cpu_s": round(cpu.children_user + cpu.children_system, 3),
                        **_marks, "finished": time.time(), **extra}) + "\n"
