@@ -69,10 +69,18 @@ def _arrow_vectors(arrows) -> tuple[list, list]:
     return origins, vectors
 
 
-def _log_entity(rec: rr.RecordingStream, entity) -> None:
-    """One SceneEntity as Rerun archetypes under markers/<id>, placed in its /tf frame."""
+_PRIMITIVES = ("spheres", "cubes", "cylinders", "arrows", "lines", "texts")
+
+
+def _log_entity(rec: rr.RecordingStream, entity, drawn: dict[str, set[str]]) -> None:
+    """One SceneEntity as Rerun archetypes under markers/<id>, placed in its /tf frame. An entity replaces the
+    one of the same id (Foxglove's rule): the kinds of primitive it no longer has (contacts gone) are cleared."""
     path = f"markers/{entity.id or entity.frame_id}"
     rec.log(path, rr.CoordinateFrame(entity.frame_id or "world"))
+    present = {kind for kind in _PRIMITIVES if getattr(entity, kind)}
+    for kind in drawn.get(path, set()) - present:
+        rec.log(f"{path}/{kind}", rr.Clear(recursive=False))
+    drawn[path] = present
     if entity.spheres:
         rec.log(f"{path}/spheres", rr.Ellipsoids3D(
             centers=[_xyz(s.pose.position) for s in entity.spheres],
@@ -112,12 +120,14 @@ def _log_entity(rec: rr.RecordingStream, entity) -> None:
 def _log_markers(rec: rr.RecordingStream, run_path: Path) -> None:
     with open(run_path, "rb") as f:
         reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        drawn: dict[str, set[str]] = {}
         for _schema, _channel, message, update in reader.iter_decoded_messages(topics=[MARKERS]):
             rec.set_time(TIMELINE, duration=message.log_time / 1e9)
             for deletion in update.deletions:
                 rec.log(f"markers/{deletion.id}", rr.Clear(recursive=True))
+                drawn.pop(f"markers/{deletion.id}", None)
             for entity in update.entities:
-                _log_entity(rec, entity)
+                _log_entity(rec, entity, drawn)
 
 
 def _log_transforms(rec: rr.RecordingStream, topic: str, frame) -> None:

@@ -1,7 +1,7 @@
 """Shapes to draw on `/markers` (Foxglove SceneUpdate): Foxglove's 3D panel renders them natively, and
 `python -m analysis.view` draws them in Rerun. An entity lives in a /tf frame and moves with it: spheres on
-frames, capsules, cones and rods between points, arrows (forces), line strips (paths), height fields (terrain),
-and a generated MuJoCo model drawn from its own geoms (`mujoco_geoms`)."""
+frames, capsules, cones and rods between points, arrows (forces), contact points with their force arrows, line
+strips (paths), height fields (terrain), and a generated MuJoCo model drawn from its own geoms (`mujoco_geoms`)."""
 
 from __future__ import annotations
 
@@ -113,16 +113,37 @@ def line_strip(name: str, points: np.ndarray, frame: str = "world", thickness: f
     return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True, lines=[line])
 
 
+def _arrow(origin, vector, color, diameter: float) -> schemas.ArrowPrimitive:
+    """Foxglove's ArrowPrimitive points along +x of its pose, so the pose turns x onto `vector`."""
+    length = float(np.linalg.norm(vector))
+    head = min(0.3 * length, 4 * diameter)
+    return schemas.ArrowPrimitive(pose=_pose(origin, _onto((1.0, 0.0, 0.0), vector)), shaft_length=length - head,
+                                  shaft_diameter=diameter, head_length=head, head_diameter=2.5 * diameter,
+                                  color=_color(color))
+
+
 def arrow(name: str, frame: str, vector: Sequence[float], color: Sequence[float], scale: float = 1.0,
           diameter: float = 0.004) -> schemas.SceneEntity:
     """An arrow from the origin of /tf frame `frame` along `vector` (in that frame) times `scale` (a force in
-    N drawn at `scale` m/N): Foxglove's ArrowPrimitive points along +x of its pose, so the pose turns x onto it."""
-    v = np.asarray(vector, dtype=float) * scale
-    length = float(np.linalg.norm(v))
-    head = min(0.3 * length, 4 * diameter)
-    return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True, arrows=[schemas.ArrowPrimitive(
-        pose=_pose((0.0, 0.0, 0.0), _onto((1.0, 0.0, 0.0), v)), shaft_length=length - head, shaft_diameter=diameter,
-        head_length=head, head_diameter=2.5 * diameter, color=_color(color))])
+    N drawn at `scale` m/N)."""
+    return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True, arrows=[
+        _arrow((0.0, 0.0, 0.0), np.asarray(vector, dtype=float) * scale, color, diameter)])
+
+
+CONTACT_RGBA = (0.9, 0.1, 0.1, 1.0)
+
+
+def contacts(name: str, points: np.ndarray, forces: np.ndarray, scale: float, frame: str = "world",
+             color: Sequence[float] = CONTACT_RGBA, diameter: float = 0.004) -> schemas.SceneEntity:
+    """Contact points (c, 3) in `frame` as small balls, each with its force (c, 3; N) as an arrow from the
+    point, drawn at `scale` m/N. No contact (c = 0) gives an empty entity: logged under the same `name`, it
+    replaces the previous instant's contacts."""
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    forces = np.asarray(forces, dtype=float).reshape(-1, 3) * scale
+    return schemas.SceneEntity(
+        frame_id=frame, id=name, frame_locked=True,
+        spheres=[_ball(p, diameter, color) for p in points],
+        arrows=[_arrow(p, f, color, diameter) for p, f in zip(points, forces, strict=True) if f.any()])
 
 
 def _z_axis(quat_wxyz: Sequence[float]) -> np.ndarray:
