@@ -96,14 +96,6 @@ def cone(name: str, frame: str, start: Sequence[float], end: Sequence[float], ra
                                cylinders=[_cylinder(start, end, radius_start, radius_end, color)])
 
 
-def rods(name: str, frame: str, segments: Sequence[tuple[Sequence[float], Sequence[float]]], radius: float,
-         color: Sequence[float]):
-    """Cylinders of one radius joining each (start, end) pair of points given in `frame`: the links of a
-    linkage drawn in their own /tf frames."""
-    return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True,
-                               cylinders=[_cylinder(a, b, radius, radius, color) for a, b in segments])
-
-
 def line_strip(name: str, points: np.ndarray, frame: str = "world", thickness: float = 0.005,
                color: Sequence[float] = (0.2, 0.2, 0.2, 1.0)):
     """A polyline through `points` (N, 3) in `frame` (a path: of a tracer point, a foot, an end effector)."""
