@@ -279,3 +279,25 @@ def test_contacts_are_drawn_as_points_with_force_arrows(slug, paper_runs):
     contacts = scene[scene["entities.0.id"] == "contacts"]
     drawn = (contacts.filter(regex=r"^entities\.0\.arrows\.\d+\.shaft_length$").fillna(0) > 0).any(axis=1)
     assert drawn.sum() > 1 and np.diff(contacts.index).min() > 0
+
+
+@pytest.mark.skipif(shutil.which("rerun") is None, reason="rerun CLI (rerun-sdk) not on PATH")
+def test_view_places_every_marker_in_its_frame(tmp_path):
+    """Each archetype converted from /markers carries its /tf frame (a child entity does not inherit its parent's
+    CoordinateFrame: geometry without one is drawn nowhere), and contacts gone are cleared."""
+    from analysis import view
+
+    path = tmp_path / "r.mcap"
+    with RunWriter(path, {"run_id": "r", "slug": "demo"}) as w:
+        w.log_transforms(np.zeros(1), "world", ["pad"], np.eye(4)[None, None])
+        w.log_contacts(np.array([0.0, 0.1]), [np.zeros((1, 3)), np.zeros((0, 3))],
+                       [np.array([[0.0, 0.0, 5.0]]), np.zeros((0, 3))], 0.01, frame="pad")
+        w.close("ok")
+    printed = subprocess.run(["rerun", "rrd", "print", str(view.convert(path, tmp_path / "r.rrd"))], check=True,
+                             env=ENV, capture_output=True, text=True, timeout=120).stdout
+    geometry = [line for line in printed.splitlines() if "/markers/" in line and ("Arrows3D" in line or
+                                                                                 "Ellipsoids3D" in line)]
+    assert {"/markers/contacts/arrows", "/markers/contacts/spheres"} <= {line.split(" - ")[1] for line in geometry}
+    assert all("CoordinateFrame:frame" in line for line in geometry)
+    cleared = {line.split(" - ")[1] for line in printed.splitlines() if "Clear:is_recursive" in line}
+    assert cleared == {"/markers/contacts/arrows", "/markers/contacts/spheres"}   # the second instant has none
