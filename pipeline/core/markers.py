@@ -1,6 +1,6 @@
 """Shapes to draw on `/markers` (Foxglove SceneUpdate): Foxglove's 3D panel renders them natively, and
 `python -m analysis.view` draws them in Rerun. An entity lives in a /tf frame and moves with it: spheres on
-frames, capsules, cones and rods between points, arrows (forces), contact points with their force arrows, line
+frames, capsules and cones between points, arrows (forces), contact points with their force arrows, line
 strips (paths), height fields (terrain), and a generated MuJoCo model drawn from its own geoms (`mujoco_geoms`)."""
 
 from __future__ import annotations
