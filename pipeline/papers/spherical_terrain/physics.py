@@ -115,7 +115,8 @@ def lift(terrain: CosineTerrain, p: np.ndarray, velocity_xy: np.ndarray) -> np.n
 
 def closed_loop(cfg: DictConfig, m: Model, paths: list[str]) -> dict[str, np.ndarray]:
     """The controller of eqs. (55)-(58) driving MuJoCo balls, every control step (system.dt) recorded:
-    ball centre, linear velocity, attitude (w, x, y, z), body angular velocity, and the commanded world ω."""
+    ball centre, linear velocity, attitude (w, x, y, z), body angular velocity, and the commanded world ω; and
+    every system.tf_dt each ball's terrain contact (ground_contacts)."""
     import mujoco
 
     from pipeline.robotics.mjcf import check_mujoco
@@ -139,11 +140,14 @@ def closed_loop(cfg: DictConfig, m: Model, paths: list[str]) -> dict[str, np.nda
            (("center", 3), ("velocity", 3), ("quat", 4), ("omega_body", 3), ("omega_command", 3),
             ("contact_point", 3), ("contact_force", 3))}
     ball_of_geom = {mj_model.geom(f"ball{b}").id: b for b in range(k)}
+    contacts_every = max(1, round(s.tf_dt / dt))   # drawn at the /tf rate: recorded there only (NaN between)
+    out["contact_point"][:], out["contact_force"][:] = np.nan, np.nan
     steer = m.gains.steering
     for i in range(steps + 1):
         out["center"][i], out["velocity"][i], out["quat"][i], out["omega_body"][i] = \
             qpos[:, :3], qvel[:, :3], qpos[:, 3:], qvel[:, 3:]
-        out["contact_point"][i], out["contact_force"][i] = ground_contacts(mj_model, data, ball_of_geom)
+        if i % contacts_every == 0:
+            out["contact_point"][i], out["contact_force"][i] = ground_contacts(mj_model, data, ball_of_geom)
         state[:, :3] = contact_point(m.terrain, qpos[:, :3], radius, state[:, :3], iterations=3)
         c = controls(m, state, p_d[i], v_d[i])
         omega = shell_angular_velocity(c, radius)
