@@ -94,7 +94,7 @@ def _periods(cfg: DictConfig) -> tuple[float, float]:
 # -- logging ---------------------------------------------------------------------------------------------------
 
 
-FORCE_SCALE = 2e-3   # m/N: the standing robot's ~40 N per foot drawn 8 cm long
+FORCE_SCALE = 0.01   # m/N: the standing robot's 4-9 N per foot drawn 4-9 cm long
 
 
 def log_model(log: RunWriter, plant: Plant) -> None:
