@@ -11,10 +11,10 @@ from omegaconf import DictConfig, OmegaConf
 from pipeline.core import schemas
 from pipeline.core.experiment import Case
 from pipeline.core.runlog import RunWriter
-from pipeline.papers.scara_half_derivative import mujoco_model
 from pipeline.papers.scara_half_derivative.arm import EXTERNAL, JOINTS, LINKS, Arm, fk, ik, jacobian, link_frames
 from pipeline.papers.scara_half_derivative.closed_loop import ClosedLoopRun, PlantSettings, make_plant, run_closed_loop
 from pipeline.papers.scara_half_derivative.controller import CartesianController, Gains
+from pipeline.papers.scara_half_derivative.mujoco_model import model_xml, qpos
 from pipeline.papers.scara_half_derivative.setpoint import Motion
 
 
@@ -54,8 +54,8 @@ def log_arm(log: RunWriter, arm: Arm, t: np.ndarray, q: np.ndarray) -> None:
     """The arm drawn: its MuJoCo model attached as model.xml, its URDF, joint states and link frames
     (mujoco_model: the closed chain's spanning tree, with the parallelogram's passive joints), and the paper's
     base frame placed at the world origin."""
-    log.attach("model.xml", mujoco_model.model_xml(arm), "application/xml")
-    log.log_robot(t, mujoco_model.qpos(q))
+    log.attach("model.xml", model_xml(arm), "application/xml")
+    log.log_robot(t, qpos(q))
     log.log_transforms(t[:1], "world", ["base"], np.eye(4)[None, None])
 
 
