@@ -69,55 +69,67 @@ def _arrow_vectors(arrows) -> tuple[list, list]:
     return origins, vectors
 
 
-def _log_entity(rec: rr.RecordingStream, entity) -> None:
-    """One SceneEntity as Rerun archetypes under markers/<id>, placed in its /tf frame."""
+_PRIMITIVES = ("spheres", "cubes", "cylinders", "arrows", "lines", "texts")
+
+
+def _log_entity(rec: rr.RecordingStream, entity, drawn: dict[str, set[str]]) -> None:
+    """One SceneEntity as Rerun archetypes under markers/<id>, placed in its /tf frame. An entity replaces the
+    one of the same id (Foxglove's rule): the kinds of primitive it no longer has (contacts gone) are cleared."""
     path = f"markers/{entity.id or entity.frame_id}"
-    rec.log(path, rr.CoordinateFrame(entity.frame_id or "world"))
+    # every archetype carries the frame itself: a child entity does not inherit its parent's CoordinateFrame,
+    # and geometry without one hangs off no named frame (Rerun then draws nothing)
+    frame = rr.CoordinateFrame(entity.frame_id or "world")
+    present = {kind for kind in _PRIMITIVES if getattr(entity, kind)}
+    for kind in drawn.get(path, set()) - present:
+        rec.log(f"{path}/{kind}", rr.Clear(recursive=False))
+    drawn[path] = present
     if entity.spheres:
         rec.log(f"{path}/spheres", rr.Ellipsoids3D(
             centers=[_xyz(s.pose.position) for s in entity.spheres],
             half_sizes=[[s.size.x / 2, s.size.y / 2, s.size.z / 2] for s in entity.spheres],
             quaternions=[_xyzw(s.pose.orientation) for s in entity.spheres],
-            colors=[_rgba(s.color) for s in entity.spheres], fill_mode="solid"))
+            colors=[_rgba(s.color) for s in entity.spheres], fill_mode="solid"), frame)
     if entity.cubes:
         rec.log(f"{path}/cubes", rr.Boxes3D(
             centers=[_xyz(c.pose.position) for c in entity.cubes], sizes=[_xyz(c.size) for c in entity.cubes],
             quaternions=[_xyzw(c.pose.orientation) for c in entity.cubes],
-            colors=[_rgba(c.color) for c in entity.cubes], fill_mode="solid"))
+            colors=[_rgba(c.color) for c in entity.cubes], fill_mode="solid"), frame)
     if entity.cylinders:
         c = entity.cylinders
         rec.log(f"{path}/cylinders", rr.Cylinders3D(
             lengths=[x.size.z for x in c], radii=[x.size.x / 2 for x in c],
             centers=[_xyz(x.pose.position) for x in c], quaternions=[_xyzw(x.pose.orientation) for x in c],
-            colors=[_rgba(x.color) for x in c], fill_mode="solid"))
+            colors=[_rgba(x.color) for x in c], fill_mode="solid"), frame)
     if entity.arrows:
         origins, vectors = _arrow_vectors(entity.arrows)
         rec.log(f"{path}/arrows", rr.Arrows3D(origins=origins, vectors=vectors,
                                               radii=[a.shaft_diameter / 2 for a in entity.arrows],
-                                              colors=[_rgba(a.color) for a in entity.arrows]))
+                                              colors=[_rgba(a.color) for a in entity.arrows]), frame)
     if entity.lines:
         rec.log(f"{path}/lines", rr.LineStrips3D([[_xyz(p) for p in line.points] for line in entity.lines],
                                                  radii=[line.thickness / 2 for line in entity.lines],
-                                                 colors=[_rgba(line.color) for line in entity.lines]))
+                                                 colors=[_rgba(line.color) for line in entity.lines]), frame)
     for k, mesh in enumerate(entity.triangles):
         rec.log(f"{path}/triangles{k}", rr.Mesh3D(
             vertex_positions=[_xyz(p) for p in mesh.points],
             triangle_indices=np.asarray(mesh.indices, dtype=np.uint32).reshape(-1, 3),
-            albedo_factor=_rgba(mesh.color)))
+            albedo_factor=_rgba(mesh.color)), frame)
     if entity.texts:
         rec.log(f"{path}/texts", rr.Points3D([_xyz(x.pose.position) for x in entity.texts],
-                                             labels=[x.text for x in entity.texts], radii=0.0))
+                                             labels=[x.text for x in entity.texts], radii=0.0), frame)
 
 
 def _log_markers(rec: rr.RecordingStream, run_path: Path) -> None:
     with open(run_path, "rb") as f:
         reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        drawn: dict[str, set[str]] = {}
         for _schema, _channel, message, update in reader.iter_decoded_messages(topics=[MARKERS]):
             rec.set_time(TIMELINE, duration=message.log_time / 1e9)
             for deletion in update.deletions:
                 rec.log(f"markers/{deletion.id}", rr.Clear(recursive=True))
+                drawn.pop(f"markers/{deletion.id}", None)
             for entity in update.entities:
-                _log_entity(rec, entity)
+                _log_entity(rec, entity, drawn)
 
 
 def _log_transforms(rec: rr.RecordingStream, topic: str, frame) -> None:

@@ -37,9 +37,10 @@ def test_worked_example_and_four_bar_to_report(data_dir):
     assert {"/joint_state", "/reference", "/tracking_error", "/tf", "/markers"} <= set(replay.topic_names)
     assert list(replay["/joint_state"].filter(like="position.").columns) == [
         "position.crank_A", "position.coupler", "position.rocker_B"]
-    assert "model.yaml" in replay.attachments
+    assert {"model.yaml", "model.xml", "robot.urdf"} <= set(replay.attachments)   # the links: the model's URDF
+    assert {"/robot_description", "/joint_states"} <= set(replay.topic_names)
     markers = replay["/markers"]
-    assert markers.filter(like="cylinders").shape[1] > 0 and markers.filter(like="lines").shape[1] > 0
+    assert markers.filter(like="spheres").shape[1] > 0 and markers.filter(like="lines").shape[1] > 0
     ids = markers.filter(regex=r"^entities\.\d+\.id$").iloc[0].tolist()
     assert len(ids) == len(set(ids))                   # Foxglove replaces an entity by a later one of the same id
     assert {"/command", "/passage"} <= set(runs["servo-2to5-computed-torque"].topic_names)

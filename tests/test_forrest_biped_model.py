@@ -179,18 +179,24 @@ def test_inverse_dynamics_terms_match_mujocos_inverse():
     assert np.allclose(ours, data.qfrc_inverse, atol=1e-9)
 
 
-def test_markers_draw_every_body_with_its_geoms():
-    import mujoco
+def test_robot_description_draws_every_body_with_its_geoms():
+    """The URDF a walking run carries (pipeline.robotics.urdf) has every body's geoms as visuals."""
+    import io
 
-    from pipeline.core.markers import mujoco_geoms
+    import mujoco
+    import yourdfpy
+
+    from pipeline.robotics.urdf import describe
 
     biped = build(SYSTEM)
-    model = mujoco.MjModel.from_xml_string(biped.xml)
-    entities = {e.frame_id: e for e in mujoco_geoms(model, biped.body_names)}
-    assert set(entities) == set(biped.body_names)
-    thigh = entities["l_link9"]                                  # one capsule: a cylinder and two end spheres
-    assert len(thigh.cylinders) == 1 and len(thigh.spheres) == 2
-    assert thigh.cylinders[0].size.z == pytest.approx(0.405)
-    foot = entities["r_link18"]                                  # plate (a box: a cube), four corner spheres
-    corners = [s for s in foot.spheres if s.size.x == pytest.approx(2 * SYSTEM["model"]["corner_radius"])]
-    assert len(foot.cubes) == 1 and len(corners) == 4
+    description = describe(mujoco.MjModel.from_xml_string(biped.xml))
+    urdf = yourdfpy.URDF.load(io.StringIO(description.urdf()), load_meshes=False, load_collision_meshes=False)
+    visuals = {name: [v.geometry for v in urdf.link_map[f"{description.name}/{name}"].visuals]
+               for name in biped.body_names}
+    assert all(visuals.values())
+    thigh = visuals["l_link9"]                                   # one capsule: a cylinder and two end spheres
+    assert [g.cylinder.length for g in thigh if g.cylinder] == pytest.approx([0.405])
+    assert sum(g.sphere is not None for g in thigh) == 2
+    foot = visuals["r_link18"]                                   # plate (a box), four corner spheres
+    corners = [g for g in foot if g.sphere and g.sphere.radius == pytest.approx(SYSTEM["model"]["corner_radius"])]
+    assert sum(g.box is not None for g in foot) == 1 and len(corners) == 4

@@ -179,3 +179,125 @@ def test_view_writes_under_data_views(tmp_path):
     out = view.convert(run_dir / "r.mcap")
     assert out == tmp_path / "views" / "demo" / "e" / "r.rrd" and out.stat().st_size > 0
     assert sorted(p.name for p in run_dir.iterdir()) == ["r.mcap"]
+
+
+# -- every articulated paper: one short run each, simulated in-process ----------------------------------------
+# (experiment, overrides that shorten it, the case drawn, whether the run's own /tf names the model's bodies)
+PAPER_RUNS = {
+    "ur5-ik-fsm": ("singular-paths", ["scenario.paths=[wrist]", "scenario.duration=0.5"], "wrist-near-alg1", False),
+    "curve-discretization": ("snake-gait", ["scenario.duration=0.2", "scenario.joints=6"], "lateral-undulation", False),
+    "gripper-force-control": ("pick-and-place", [], None, False),
+    "partial-lagrangian": ("two-link", ["scenario.pd.duration=0.3"], "pd", False),
+    "cobot-6r-ik": ("trajectory", ["scenario.duration=0.2"], "line", False),
+    "nmpc-cdkd": ("tracking", ["scenario.duration=0.6", "scenario.t0=0.1", "scenario.t1=0.5"], None, False),
+    "scara-half-derivative": ("table2", ["scenario.duration=0.1", "scenario.k_xyz=[80000]",
+                                         "scenario.controllers=[kd]"], None, False),
+    "spherical-terrain": ("physics-check", ["system.duration=0.5", "scenario.classes=[rt]"], None, False),
+    "src-joint": ("joint-model", ["scenario.duration=0.5", "scenario.plants=[mujoco]"], "mujoco-corrected", False),
+    "admittance-assembly": ("mujoco-crosscheck", ["scenario.cases=[spatial]", "scenario.runs=[static]",
+                                                  "scenario.admittance=isotropic"], None, False),
+    "srs-collision-avoidance": ("circle", ["scenario.cases=[avoid]", "system.task.samples=40"], None, False),
+    "quadruped-irondog": ("stand", ["scenario.duration=0.2", "scenario.payloads=[0]"], None, True),
+    "forrest-biped": ("walking", ["system.walk.duration=0.6", "scenario.window=[0.2,0.6]",
+                                  "scenario.lipm_zmp_lags=[0.0]"], "traditional", True),
+    "dyad-triad-synthesis": ("four-bar", ["scenario.leg_duration=0.1"], "replay-1to5", True),
+}
+
+
+@pytest.fixture(scope="module")
+def paper_runs(tmp_path_factory):
+    """Runs are made on demand, one per paper, in this process (no CLI start-up)."""
+    from pipeline.core.checks import compose_config
+    from pipeline.core.experiment import resolve
+
+    made: dict[str, object] = {}
+
+    def run(slug: str):
+        if slug not in made:
+            name, overrides, case_id, _ = PAPER_RUNS[slug]
+            cfg = compose_config([f"experiment={slug}/{name}", *overrides])
+            cases = resolve(f"{slug}/{name}").fn(cfg)
+            case = next(c for c in cases if case_id is None or c.id == case_id)
+            path = tmp_path_factory.mktemp(slug) / f"{case.id}.mcap"
+            with RunWriter(path, {"run_id": case.id, "slug": slug}) as w:
+                case.simulate(w)
+                w.close("ok")
+            made[slug] = read_run(path)
+        return made[slug]
+
+    return run
+
+
+def _urdf(run) -> yourdfpy.URDF:
+    return yourdfpy.URDF.load(io.StringIO(run["/robot_description"]["data"].iloc[0]), load_meshes=False,
+                              load_collision_meshes=False)
+
+
+def _joint_state_names(run) -> list[str]:
+    columns = run["/joint_states"].columns
+    return [c.removeprefix("joints.").removesuffix(".name") for c in columns if c.endswith(".name")]
+
+
+@pytest.mark.parametrize("slug", sorted(PAPER_RUNS))
+def test_every_articulated_paper_draws_its_robot(slug, paper_runs):
+    """The run carries its URDF; it parses, its movable joints are the joint-state channel's, and its FK equals
+    MuJoCo's on the attached model at random states; where the paper's /tf names the model's bodies, the URDF
+    moved by the logged joint states puts them there."""
+    run = paper_runs(slug)
+    assert {robot.ROBOT_DESCRIPTION, robot.JOINT_STATES, robot.ROBOT_TF} <= set(run.topic_names)
+    urdf = _urdf(run)
+    assert sorted(urdf.actuated_joint_names) == sorted(_joint_state_names(run))
+    model = mujoco.MjModel.from_xml_string(run.attachments["model.xml"].decode())
+    description = describe(model)
+    assert description.urdf() == run.attachments[robot.URDF_ATTACHMENT].decode()
+    qpos, mocap_pos, mocap_quat = random_states(model, 3, seed=7)
+    positions = description.joint_positions(qpos, mocap_pos, mocap_quat)
+    for q, (xpos, xmat) in zip(positions, mujoco_poses(model, qpos, mocap_pos, mocap_quat), strict=True):
+        urdf.update_cfg(dict(zip(description.joint_names, q, strict=True)))
+        for b in range(1, model.nbody):
+            T = urdf.get_transform(f"{description.name}/{model.body(b).name}", "world")
+            assert np.allclose(T[:3, 3], xpos[b], atol=1e-9) and np.allclose(T[:3, :3], xmat[b], atol=1e-9)
+    if PAPER_RUNS[slug][3]:
+        states, tf = run["/joint_states"], run["/tf"]
+        names = _joint_state_names(run)
+        shared = [model.body(b).name for b in range(1, model.nbody)
+                  if f"transforms.{model.body(b).name}.translation.x" in tf.columns]
+        assert shared
+        for t in states.index[::max(1, len(states) // 4)].intersection(tf.index):
+            urdf.update_cfg({n: states.loc[t, f"joints.{n}.position"] for n in names})
+            for body in shared:
+                logged = [tf.loc[t, f"transforms.{body}.translation.{a}"] for a in "xyz"]
+                assert np.allclose(urdf.get_transform(f"{description.name}/{body}", "world")[:3, 3], logged,
+                                   atol=1e-9), (body, t)
+
+
+@pytest.mark.parametrize("slug", ["admittance-assembly", "forrest-biped", "quadruped-irondog", "spherical-terrain",
+                                  "src-joint"])
+def test_contacts_are_drawn_as_points_with_force_arrows(slug, paper_runs):
+    """Contact forces on /markers: an arrow from each contact point, sent again at every drawn instant."""
+    scene = paper_runs(slug)["/markers"]
+    contacts = scene[scene["entities.0.id"] == "contacts"]
+    drawn = (contacts.filter(regex=r"^entities\.0\.arrows\.\d+\.shaft_length$").fillna(0) > 0).any(axis=1)
+    assert drawn.sum() > 1 and np.diff(contacts.index).min() > 0
+
+
+@pytest.mark.skipif(shutil.which("rerun") is None, reason="rerun CLI (rerun-sdk) not on PATH")
+def test_view_places_every_marker_in_its_frame(tmp_path):
+    """Each archetype converted from /markers carries its /tf frame (a child entity does not inherit its parent's
+    CoordinateFrame: geometry without one is drawn nowhere), and contacts gone are cleared."""
+    from analysis import view
+
+    path = tmp_path / "r.mcap"
+    with RunWriter(path, {"run_id": "r", "slug": "demo"}) as w:
+        w.log_transforms(np.zeros(1), "world", ["pad"], np.eye(4)[None, None])
+        w.log_contacts(np.array([0.0, 0.1]), [np.zeros((1, 3)), np.zeros((0, 3))],
+                       [np.array([[0.0, 0.0, 5.0]]), np.zeros((0, 3))], 0.01, frame="pad")
+        w.close("ok")
+    printed = subprocess.run(["rerun", "rrd", "print", str(view.convert(path, tmp_path / "r.rrd"))], check=True,
+                             env=ENV, capture_output=True, text=True, timeout=120).stdout
+    geometry = [line for line in printed.splitlines() if "/markers/" in line and ("Arrows3D" in line or
+                                                                                 "Ellipsoids3D" in line)]
+    assert {"/markers/contacts/arrows", "/markers/contacts/spheres"} <= {line.split(" - ")[1] for line in geometry}
+    assert all("CoordinateFrame:frame" in line for line in geometry)
+    cleared = {line.split(" - ")[1] for line in printed.splitlines() if "Clear:is_recursive" in line}
+    assert cleared == {"/markers/contacts/arrows", "/markers/contacts/spheres"}   # the second instant has none

@@ -100,3 +100,32 @@ def test_trapezoid_profile():
     assert np.trapezoid(a, t) == pytest.approx(0.0, abs=1e-9)
     with pytest.raises(ValueError):
         trapezoid(t, 1.0, 1.0, 0.6)
+
+
+def test_mujoco_model_is_the_same_arm(arm):
+    """The attached MJCF (what a viewer draws) is the arm: its bodies at link_frames, E at eq. (3)-(6), the
+    parallelogram's constraint closed, and its mass matrix and holding torque (gravity and spring, reduced by
+    the loop map) equal to the link model's and eq. (12)."""
+    import mujoco
+
+    from pipeline.papers.scara_half_derivative import mujoco_model
+    from pipeline.papers.scara_half_derivative.arm import LINKS, gravity_torque, mass_matrix_from_links
+
+    model = mujoco.MjModel.from_xml_string(mujoco_model.model_xml(arm))
+    data = mujoco.MjData(model)
+    assert tuple(model.joint(j).name for j in range(model.njnt)) == mujoco_model.QPOS_JOINTS
+    bodies = [model.body(name).id for name in LINKS]
+    loop = mujoco_model.qpos(np.eye(4))   # (4, 6): d qpos / d θ
+    M = np.zeros((model.nv, model.nv))
+    for q in np.random.default_rng(4).uniform(-1.2, 1.2, (6, 4)):
+        data.qpos[:] = mujoco_model.qpos(q)
+        mujoco.mj_forward(model, data)
+        frames = link_frames(arm, q)
+        np.testing.assert_allclose(data.xpos[bodies], frames[:, :3, 3], atol=1e-12)
+        np.testing.assert_allclose(data.xmat[bodies].reshape(-1, 3, 3), frames[:, :3, :3], atol=1e-12)
+        np.testing.assert_allclose(data.site("E").xpos, fk(arm, q)[:3], atol=1e-12)
+        np.testing.assert_allclose(data.efc_pos[:data.ne], 0.0, atol=1e-12)
+        mujoco.mj_fullM(model, data, M)
+        np.testing.assert_allclose(loop @ M @ loop.T, mass_matrix_from_links(arm, q), rtol=1e-9, atol=1e-12)
+        holding = loop @ (data.qfrc_bias - data.qfrc_passive)
+        np.testing.assert_allclose(holding, [0, 0, gravity_torque(arm, q[2]), 0], atol=1e-9)

@@ -1,7 +1,7 @@
 """Shapes to draw on `/markers` (Foxglove SceneUpdate): Foxglove's 3D panel renders them natively, and
 `python -m analysis.view` draws them in Rerun. An entity lives in a /tf frame and moves with it: spheres on
-frames, capsules, cones and rods between points, arrows (forces), line strips (paths), height fields (terrain),
-and a generated MuJoCo model drawn from its own geoms (`mujoco_geoms`)."""
+frames, cones between points, arrows (forces), contact points with their force arrows, line strips (paths) and
+height fields (terrain). A robot itself is drawn from its URDF (pipeline.core.robot), not from markers."""
 
 from __future__ import annotations
 
@@ -76,32 +76,11 @@ def _ball(centre, radius: float, color) -> schemas.SpherePrimitive:
     return schemas.SpherePrimitive(pose=_pose(centre), size=schemas.Vector3(x=d, y=d, z=d), color=_color(color))
 
 
-def _cube(centre, quat_wxyz, size: Sequence[float], color) -> schemas.CubePrimitive:
-    return schemas.CubePrimitive(pose=_pose(centre, quat_wxyz), color=_color(color),
-                                 size=schemas.Vector3(x=float(size[0]), y=float(size[1]), z=float(size[2])))
-
-
-def capsule(name: str, frame: str, start: Sequence[float], end: Sequence[float], radius: float,
-            color: Sequence[float]):
-    """A capsule (a cylinder with a sphere at each end) from `start` to `end` in /tf frame `frame`."""
-    return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True,
-                               cylinders=[_cylinder(start, end, radius, radius, color)],
-                               spheres=[_ball(p, radius, color) for p in (start, end)])
-
-
 def cone(name: str, frame: str, start: Sequence[float], end: Sequence[float], radius_start: float,
          radius_end: float, color: Sequence[float]):
     """A truncated cone from `start` (radius_start) to `end` (radius_end) in /tf frame `frame`."""
     return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True,
                                cylinders=[_cylinder(start, end, radius_start, radius_end, color)])
-
-
-def rods(name: str, frame: str, segments: Sequence[tuple[Sequence[float], Sequence[float]]], radius: float,
-         color: Sequence[float]):
-    """Cylinders of one radius joining each (start, end) pair of points given in `frame`: the links of a
-    linkage drawn in their own /tf frames."""
-    return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True,
-                               cylinders=[_cylinder(a, b, radius, radius, color) for a, b in segments])
 
 
 def line_strip(name: str, points: np.ndarray, frame: str = "world", thickness: float = 0.005,
@@ -113,54 +92,34 @@ def line_strip(name: str, points: np.ndarray, frame: str = "world", thickness: f
     return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True, lines=[line])
 
 
+def _arrow(origin, vector, color, diameter: float) -> schemas.ArrowPrimitive:
+    """Foxglove's ArrowPrimitive points along +x of its pose, so the pose turns x onto `vector`."""
+    length = float(np.linalg.norm(vector))
+    head = min(0.3 * length, 4 * diameter)
+    return schemas.ArrowPrimitive(pose=_pose(origin, _onto((1.0, 0.0, 0.0), vector)), shaft_length=length - head,
+                                  shaft_diameter=diameter, head_length=head, head_diameter=2.5 * diameter,
+                                  color=_color(color))
+
+
 def arrow(name: str, frame: str, vector: Sequence[float], color: Sequence[float], scale: float = 1.0,
           diameter: float = 0.004) -> schemas.SceneEntity:
     """An arrow from the origin of /tf frame `frame` along `vector` (in that frame) times `scale` (a force in
-    N drawn at `scale` m/N): Foxglove's ArrowPrimitive points along +x of its pose, so the pose turns x onto it."""
-    v = np.asarray(vector, dtype=float) * scale
-    length = float(np.linalg.norm(v))
-    head = min(0.3 * length, 4 * diameter)
-    return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True, arrows=[schemas.ArrowPrimitive(
-        pose=_pose((0.0, 0.0, 0.0), _onto((1.0, 0.0, 0.0), v)), shaft_length=length - head, shaft_diameter=diameter,
-        head_length=head, head_diameter=2.5 * diameter, color=_color(color))])
+    N drawn at `scale` m/N)."""
+    return schemas.SceneEntity(frame_id=frame, id=name, frame_locked=True, arrows=[
+        _arrow((0.0, 0.0, 0.0), np.asarray(vector, dtype=float) * scale, color, diameter)])
 
 
-def _z_axis(quat_wxyz: Sequence[float]) -> np.ndarray:
-    """The local z axis of a unit quaternion's frame."""
-    w, x, y, z = quat_wxyz
-    return np.array([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
+CONTACT_RGBA = (0.9, 0.1, 0.1, 1.0)
 
 
-def mujoco_geoms(model, bodies: Sequence[str] | None = None, plane_size: float = 4.0) -> list:
-    """The geoms of a compiled MuJoCo model (of the named `bodies` only, if given), one entity per body in the /tf
-    frame named as the body (`world` for the world body's): boxes as cubes, spheres, cylinders, capsules as a
-    cylinder with two end spheres, planes as a thin `plane_size` square slab whose top is the plane. Log the
-    bodies' poses on /tf under the same names."""
-    import mujoco
-
-    box, sphere, cylinder, capsule_, plane = (int(k) for k in (
-        mujoco.mjtGeom.mjGEOM_BOX, mujoco.mjtGeom.mjGEOM_SPHERE, mujoco.mjtGeom.mjGEOM_CYLINDER,
-        mujoco.mjtGeom.mjGEOM_CAPSULE, mujoco.mjtGeom.mjGEOM_PLANE))
-    wanted = None if bodies is None else {mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in bodies}
-    entities: dict[int, schemas.SceneEntity] = {}
-    for g in range(model.ngeom):
-        body = int(model.geom_bodyid[g])
-        if wanted is not None and body not in wanted:
-            continue
-        frame = "world" if body == 0 else mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body)
-        entity = entities.setdefault(body, schemas.SceneEntity(frame_id=frame, id=f"geoms/{frame}",
-                                                               frame_locked=True))
-        kind, size, pos, quat = int(model.geom_type[g]), model.geom_size[g], model.geom_pos[g], model.geom_quat[g]
-        color = model.geom_rgba[g]
-        if kind == box:
-            entity.cubes.append(_cube(pos, quat, 2 * size, color))
-        elif kind == sphere:
-            entity.spheres.append(_ball(pos, size[0], color))
-        elif kind in (cylinder, capsule_):
-            half = size[1] * _z_axis(quat)
-            entity.cylinders.append(_cylinder(pos - half, pos + half, size[0], size[0], color))
-            if kind == capsule_:
-                entity.spheres.extend(_ball(end, size[0], color) for end in (pos - half, pos + half))
-        elif kind == plane:
-            entity.cubes.append(_cube(pos - 0.001 * _z_axis(quat), quat, (plane_size, plane_size, 0.002), color))
-    return list(entities.values())
+def contacts(name: str, points: np.ndarray, forces: np.ndarray, scale: float, frame: str = "world",
+             color: Sequence[float] = CONTACT_RGBA, diameter: float = 0.004) -> schemas.SceneEntity:
+    """Contact points (c, 3) in `frame` as small balls, each with its force (c, 3; N) as an arrow from the
+    point, drawn at `scale` m/N. No contact (c = 0) gives an empty entity: logged under the same `name`, it
+    replaces the previous instant's contacts."""
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    forces = np.asarray(forces, dtype=float).reshape(-1, 3) * scale
+    return schemas.SceneEntity(
+        frame_id=frame, id=name, frame_locked=True,
+        spheres=[_ball(p, diameter, color) for p in points],
+        arrows=[_arrow(p, f, color, diameter) for p, f in zip(points, forces, strict=True) if f.any()])

@@ -26,7 +26,7 @@ from mcap.records import Chunk
 from mcap.stream_reader import ReadDataStream, get_chunk_data_stream
 from mcap_protobuf.decoder import DecoderFactory
 
-from pipeline.core import files, layouts, robot, schemas
+from pipeline.core import files, layouts, markers, robot, schemas
 from pipeline.core.encoding import encode_series
 from pipeline.robotics.transforms import quaternion_wxyz
 
@@ -231,6 +231,18 @@ class RunWriter:
         self._queue(robot.ROBOT_TF, schemas.FrameTransforms).append((times_ns, robot.frame_transforms(
             times_ns, [j.parent for j in description.movable], [j.child for j in description.movable],
             trans, quats)))
+
+    def log_contacts(self, times: np.ndarray, points: Sequence[np.ndarray], forces: Sequence[np.ndarray],
+                     scale: float, name: str = "contacts", **style: Any) -> None:
+        """Contacts on `/markers`: at each of `times` (s) the points (c, 3) and forces (c, 3; N) of that instant
+        (markers.contacts, arrows at `scale` m/N), replacing the previous instant's; thinned to
+        robot.VIEW_RATE_HZ like the robot."""
+        times = np.atleast_1d(np.asarray(times, dtype=float))
+        keep = robot.thinned(times).tolist()
+        times_ns = seconds_to_ns(times[keep])
+        updates = [schemas.SceneUpdate(entities=[markers.contacts(name, points[i], forces[i], scale, **style)])
+                   .SerializeToString() for i in keep]
+        self._queue("/markers", schemas.SceneUpdate).append((times_ns, updates))
 
     def _robot_from_joint_state(self) -> None:
         """A run that attached its MuJoCo model and logged `/joint_state` under the model's joint names gets

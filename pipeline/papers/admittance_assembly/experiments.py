@@ -22,6 +22,7 @@ TWIST_NAMES = np.array(["v_x", "v_y", "v_z", "w_x", "w_y", "w_z"])
 ERROR_NAMES = ["x", "y", "z"]
 SAMPLE_DT = 1e-3  # s: samples that are not a trajectory (configurations, admittances) are logged 1 ms apart
 NEAR_GAP = 1e-4   # m: a MuJoCo contact is attributed to the nearest candidate within this gap
+CONTACT_SCALE = 0.005  # m/N: MuJoCo's contact forces (up to ~7 N) drawn 5 mm per newton beside the 5 cm peg
 
 
 # -- configuration -> model -----------------------------------------------------------------------------
@@ -293,13 +294,13 @@ def _mujoco_sample(sim, g: PegInHole, A: np.ndarray, R, p, v0, t: float, predict
     w_meas = sim.contact_wrench()
     return {"t": t, "qpos": sim.data.qpos.copy(), "v": sim.twist(), "R": R, "p": p,
             "delta": geometry.error_vector(g, R, p)[0], "w_meas": w_meas, "w_pred": w_pred,
-            "v_pred": v_pred, "law": v0 + A @ w_meas, "contacts_meas": measured,
+            "v_pred": v_pred, "law": v0 + A @ w_meas, "contacts_meas": measured, "points": points, "forces": forces,
             "contacts_pred": lam[:, None] * c.normal[0], "mujoco_contacts": len(points),
             "predicted_contacts": int((lam > 0).sum()), "penetration": -min(dist, 0.0)}
 
 
 def _log_mujoco(log: RunWriter, g: PegInHole, sim, rows: list[dict], t: np.ndarray, tf_dt: float) -> None:
-    col = {k: np.array([r[k] for r in rows]) for k in rows[0] if k != "t"}
+    col = {k: np.array([r[k] for r in rows]) for k in rows[0] if k not in ("t", "points", "forces")}
     qpos_names = [sim.model.joint(i).name for i in range(sim.model.njnt)] if g.planar else \
         ["x", "y", "z", "qw", "qx", "qy", "qz"]
     log.log_series("/joint_state", t, name=qpos_names, position=col["qpos"])
@@ -324,3 +325,7 @@ def _log_mujoco(log: RunWriter, g: PegInHole, sim, rows: list[dict], t: np.ndarr
                                           np.linalg.norm(col["v"] - col["law"], axis=1), col["mujoco_contacts"],
                                           col["predicted_contacts"], col["penetration"]]))
     log_pose(log, t, col["R"], col["p"], t[1] - t[0] if len(t) > 1 else 1.0, tf_dt)
+    every = max(1, round(tf_dt / (t[1] - t[0]))) if len(t) > 1 else 1
+    log.log_robot(t[::every], col["qpos"][::every])
+    log.log_contacts(t[::every], [r["points"] for r in rows[::every]], [r["forces"] for r in rows[::every]],
+                     CONTACT_SCALE, diameter=0.0008)

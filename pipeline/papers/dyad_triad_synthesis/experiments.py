@@ -16,7 +16,7 @@ from pipeline.core import markers, schemas
 from pipeline.core.experiment import Case
 from pipeline.core.runlog import RunWriter, SimulationFailed
 from pipeline.core.timing import time_interleaved
-from pipeline.papers.dyad_triad_synthesis import burmester, fourbar, multibody, synthetic
+from pipeline.papers.dyad_triad_synthesis import burmester, fourbar, mujoco_model, multibody, synthetic
 from pipeline.papers.dyad_triad_synthesis.compatibility import (
     BRANCHES,
     Compatibility,
@@ -354,31 +354,15 @@ def _frames(model: multibody.ExudynFourBar, q: np.ndarray) -> np.ndarray:
 FRAMES = ["crank_A", "coupler", "rocker_B", "tracer"]
 
 
-def _scene(model: multibody.ExudynFourBar, path: np.ndarray, targets: np.ndarray, radius: float):
-    """The links as rods in their frames, pivots as spheres, the precision points and the tracer's path."""
-    f = model.fourbar
-
-    def xyz(z: complex) -> tuple[float, float, float]:
-        return (z.real, z.imag, 0.0)
-
-    def local(z: complex, origin: complex) -> tuple[float, float, float]:
-        return xyz(z - origin)
-
-    entities = [
-        # entity ids differ from the frame names: the pivot spheres below are named after their frames
-        markers.rods("crank_A.link", "crank_A", [((0, 0, 0), local(f.a1, f.a0))], radius, (0.85, 0.33, 0.1, 1.0)),
-        markers.rods("coupler.link", "coupler", [((0, 0, 0), local(f.b1, f.a1)), ((0, 0, 0), local(f.p, f.a1)),
-                                                 (local(f.b1, f.a1), local(f.p, f.a1))], radius,
-                     (0.2, 0.45, 0.75, 1.0)),
-        markers.rods("rocker_B.link", "rocker_B", [((0, 0, 0), local(f.b1, f.b0))], radius, (0.3, 0.65, 0.3, 1.0)),
-        markers.rods("ground.link", "world", [(xyz(f.a0), xyz(f.b0))], radius / 2, (0.4, 0.4, 0.4, 1.0)),
+def _scene(path: np.ndarray, targets: np.ndarray, radius: float):
+    """The pivots as spheres, the precision points and the tracer's path (the links are the model's URDF)."""
+    return schemas.SceneUpdate(entities=[
         *markers.spheres(["crank_A", "rocker_B", "tracer"], [2 * radius] * 3, [(0.1, 0.1, 0.1, 1.0)] * 3),
         markers.line_strip("tracer_path", np.column_stack([path.real, path.imag, np.zeros(len(path))]),
                            thickness=radius / 2, color=(0.8, 0.1, 0.1, 1.0)),
         markers.line_strip("precision_points", np.column_stack([targets.real, targets.imag, np.zeros(len(targets))]),
                            thickness=radius / 4, color=(0.1, 0.1, 0.1, 0.6)),
-    ]
-    return schemas.SceneUpdate(entities=entities)
+    ])
 
 
 def _model_yaml(model: multibody.ExudynFourBar, cfg: DictConfig) -> str:
@@ -428,8 +412,11 @@ def _log_motion(log: RunWriter, cfg: DictConfig, model: multibody.ExudynFourBar,
     log.log_series("/joint_gap", ts, schemas.Scalars, name=["a0", "a1", "b1", "b0"], value=gaps)
     tf = slice(None, None, max(1, round(ex.tf_dt / dt)))
     log.log_transforms(t[tf], "world", FRAMES, _frames(model, q[tf]))
+    log.attach("model.xml", mujoco_model.model_xml(model.fourbar, model.bodies, cfg.system.linkage.link_radius),
+               "application/xml")
+    log.log_robot(t[tf], mujoco_model.qpos(q[tf, :, 2]))
     path = multibody.points_of(model.bodies, q[tf], 1, model.fourbar.p)
-    log.write("/markers", 0, _scene(model, path, targets, cfg.system.linkage.link_radius))
+    log.write("/markers", 0, _scene(path, targets, cfg.system.linkage.link_radius))
 
 
 def _arrivals(log: RunWriter, model: multibody.ExudynFourBar, t: np.ndarray, q: np.ndarray,

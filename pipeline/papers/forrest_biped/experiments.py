@@ -27,8 +27,10 @@ from pipeline.papers.forrest_biped import generator as gen
 from pipeline.papers.forrest_biped import lipm, mechanisms, walking
 from pipeline.papers.forrest_biped.model import CORNERS, JOINTS, build
 from pipeline.papers.forrest_biped.support import support_polygons
+from pipeline.robotics.transforms import quaternion_wxyz
 
 XYZ = ["x", "y", "z"]
+FORCE_SCALE = 1e-3   # m/N: a sole's share of the robot's weight drawn some 0.1-0.3 m long
 
 Balance = schemas.define(
     "ForrestBalance",
@@ -141,12 +143,29 @@ def log_walk(log: RunWriter, p: gen.Pattern, w: walking.WalkLog, biped, tf_every
     points[:, 0, :3, 3], points[:, 1, :3, 3] = w.com[rows], w.cp[rows]
     points[:, 2, :3, 3] = np.nan_to_num(zmp[rows])
     log.log_transforms(w.tf_t, "world", [*biped.body_names, "com", "cp", "zmp"], np.concatenate([w.tf, points], 1))
-    import mujoco
-
-    robot = markers.mujoco_geoms(mujoco.MjModel.from_xml_string(biped.xml), biped.body_names)
+    log.log_robot(w.tf_t, robot_qpos(biped, w.q[rows], w.tf[:, 0]))
+    loaded = w.wrench[rows, :, 2] > 0   # the soles' measured contact forces, at the sole centres
+    log.log_contacts(w.tf_t, [f[c] for f, c in zip(w.feet[rows], loaded, strict=True)],
+                     [f[c, :3] for f, c in zip(w.wrench[rows], loaded, strict=True)], FORCE_SCALE)
     points = markers.spheres(["com", "cp", "zmp"], [0.03, 0.02, 0.02],
                              [(0.9, 0.1, 0.1, 1), (0.1, 0.3, 0.9, 1), (0.1, 0.7, 0.2, 1)])
-    log.write("/markers", 0, schemas.SceneUpdate(entities=[*robot, *points]))
+    log.write("/markers", 0, schemas.SceneUpdate(entities=points))
+
+
+def robot_qpos(biped, q: np.ndarray, base: np.ndarray) -> np.ndarray:
+    """MuJoCo qpos (m, nq) of the walking model from the joint positions q (m, 12; JOINTS) and the base body's
+    world poses (m, 4, 4): the free joint's position and attitude are the base's."""
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_string(biped.xml)
+    qpos = np.tile(model.qpos0, (len(q), 1))
+    for j in range(model.njnt):
+        adr = model.jnt_qposadr[j]
+        if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE:
+            qpos[:, adr:adr + 3], qpos[:, adr + 3:adr + 7] = base[:, :3, 3], quaternion_wxyz(base[:, :3, :3])
+        else:
+            qpos[:, adr] = q[:, JOINTS.index(model.joint(j).name)]
+    return qpos
 
 
 # -- experiments -------------------------------------------------------------------------------------------

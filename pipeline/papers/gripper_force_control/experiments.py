@@ -54,9 +54,13 @@ def run_plant(log: RunWriter, cfg: DictConfig, p: Gripper, s: Schedule, start: S
         log.log_robot(s.t[::tf_every], np.array(sim.states))
         t_tf = s.t[::tf_every]
         force = np.interp(t_tf, trace.t, trace["force"])  # the grasp force, along the pad's x (/wrench frame)
-        for t_k, f_k in zip(t_tf[robot.thinned(t_tf)], force[robot.thinned(t_tf)], strict=True):
-            log.write("/markers", seconds_to_ns(t_k), schemas.SceneUpdate(entities=[markers.arrow(
-                "grasp_force", "pad", [f_k, 0.0, 0.0], FORCE_RGBA, scale=FORCE_SCALE)]))
+        error = np.interp(t_tf, s.t, s.force) - force     # F_set − F: red, from the force arrow's tip
+        keep = robot.thinned(t_tf)
+        for t_k, f_k, e_k in zip(t_tf[keep], force[keep], error[keep], strict=True):
+            log.write("/markers", seconds_to_ns(t_k), schemas.SceneUpdate(entities=[
+                markers.arrow("grasp_force", "pad", [f_k, 0.0, 0.0], FORCE_RGBA, scale=FORCE_SCALE),
+                markers.contacts("force_error", [[FORCE_SCALE * f_k, 0.0, 0.0]], [[e_k, 0.0, 0.0]], FORCE_SCALE,
+                                 frame="pad", diameter=0.002)]))
     elif plant == "lumped":
         trace = lumped.simulate(p, s, start, log_every)
     else:

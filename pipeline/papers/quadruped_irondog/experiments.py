@@ -1,15 +1,15 @@
 """Simulate stage of `quadruped-irondog`: the paper's tables as data, the kinematics of Secs. 3.1 and 3.3, and
 the MuJoCo robot standing (Table 5), moving its body (Fig. 18), levelling itself on a tilting bench (Figs. 19-20)
 and trotting (Sec. 4.3, Figs. 21-22). Every MuJoCo run logs the common topics (joints, references, servo
-commands, tracking errors, foot contact forces on /wrench, /tf of every body with /markers to draw them) and the
-trunk's pose and IMU angles on /body."""
+commands, tracking errors, foot contact forces on /wrench and as arrows on /markers, /tf of every body, the robot
+drawn from its MuJoCo model: URDF, joint states, link frames) and the trunk's pose and IMU angles on /body."""
 
 from __future__ import annotations
 
 import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
-from pipeline.core import markers, schemas
+from pipeline.core import schemas
 from pipeline.core.experiment import Case
 from pipeline.core.runlog import RunWriter, SimulationFailed
 from pipeline.core.timing import log_timings, time_calls
@@ -94,9 +94,11 @@ def _periods(cfg: DictConfig) -> tuple[float, float]:
 # -- logging ---------------------------------------------------------------------------------------------------
 
 
+FORCE_SCALE = 0.01   # m/N: the standing robot's 4-9 N per foot drawn 4-9 cm long
+
+
 def log_model(log: RunWriter, plant: Plant) -> None:
     log.attach("model.xml", plant.xml, "application/xml")
-    log.write("/markers", 0, schemas.SceneUpdate(entities=markers.mujoco_geoms(plant.model)))
 
 
 def log_trace(log: RunWriter, plant: Plant, trace: Trace, cfg: DictConfig, q_ref: np.ndarray | None = None,
@@ -137,6 +139,10 @@ def log_trace(log: RunWriter, plant: Plant, trace: Trace, cfg: DictConfig, q_ref
     foot[..., :3, 3] += np.einsum("nkij,j->nki", poses[:, tibia, :3, :3], [0.0, 0.0, -leg.L3])
     log.log_transforms(t[::every], "world", [*bodies, *(f"{name}_foot" for name in LEGS)],
                        np.concatenate([poses, foot], axis=1))
+    log.log_robot(t[::every], trace.qpos[::every])   # the free trunk and the bench: the full MuJoCo state
+    touching = trace.contact[::every] > 0
+    log.log_contacts(t[::every], [p[c] for p, c in zip(foot[..., :3, 3], touching, strict=True)],
+                     [f[c] for f, c in zip(trace.contact_force[::every], touching, strict=True)], FORCE_SCALE)
     log.log_series("/compute_time", trace.control_t, name=["control_step"], calls=[1],
                    seconds=trace.control_seconds[:, None])
 

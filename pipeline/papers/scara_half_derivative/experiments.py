@@ -17,6 +17,7 @@ from pipeline.papers.scara_half_derivative import batch
 from pipeline.papers.scara_half_derivative.arm import EXTERNAL, JOINTS, LINKS, Arm, fk, ik, jacobian, link_frames
 from pipeline.papers.scara_half_derivative.closed_loop import ClosedLoopRun, PlantSettings, make_plant, run_closed_loop
 from pipeline.papers.scara_half_derivative.controller import CartesianController, Gains
+from pipeline.papers.scara_half_derivative.mujoco_model import model_xml, qpos
 from pipeline.papers.scara_half_derivative.setpoint import Motion
 
 Indexes = schemas.define(
@@ -72,6 +73,15 @@ def _frames_with_end_effector(arm: Arm, q: np.ndarray, x_d: np.ndarray) -> np.nd
     return np.concatenate([frames, e_frame[:, None], target[:, None]], axis=1)
 
 
+def log_arm(log: RunWriter, arm: Arm, t: np.ndarray, q: np.ndarray) -> None:
+    """The arm drawn: its MuJoCo model attached as model.xml, its URDF, joint states and link frames
+    (mujoco_model: the closed chain's spanning tree, with the parallelogram's passive joints), and the paper's
+    base frame placed at the world origin."""
+    log.attach("model.xml", model_xml(arm), "application/xml")
+    log.log_robot(t, qpos(q))
+    log.log_transforms(t[:1], "world", ["base"], np.eye(4)[None, None])
+
+
 def _plain(value):
     """Tuples (of tuples) as lists, for YAML."""
     return [_plain(v) for v in value] if isinstance(value, tuple | list) else value
@@ -115,6 +125,7 @@ def log_closed_loop(log: RunWriter, cfg: DictConfig, arm: Arm, motion: Motion, r
     tf = slice(None, None, _stride(ex.tf_dt, dt, "execute.tf_dt"))
     log.log_transforms(run.t[tf], "base", [*LINKS, "E", "setpoint"],
                        _frames_with_end_effector(arm, run.q[tf], motion(run.t[tf])[0]))
+    log_arm(log, arm, run.t[tf], run.q[tf])
 
 
 def _model_yaml(cfg: DictConfig, arm: Arm, law: str, g: Gains) -> str:
@@ -189,6 +200,7 @@ def setpoint(cfg: DictConfig) -> list[Case]:
                        value=np.abs(fk(arm, q_d) - x_d).max(axis=1)[:, None])
         tf = slice(None, None, max(1, round(cfg.scenario.tf_dt / cfg.scenario.dt)))
         log.log_transforms(t[tf], "base", [*LINKS, "E", "setpoint"], _frames_with_end_effector(arm, q_d[tf], x_d[tf]))
+        log_arm(log, arm, t[tf], q_d[tf])
 
     return [Case("setpoint", simulate)]
 

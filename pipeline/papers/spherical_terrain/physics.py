@@ -37,6 +37,7 @@ from pipeline.papers.spherical_terrain.kinematics import CosineTerrain, contact_
 from pipeline.papers.spherical_terrain.tracking import Model, controls, references, start_states
 
 CONJUGATE = np.array([1.0, -1.0, -1.0, -1.0])
+CONTACT_SCALE = 0.01   # m/N: the 2 kg ball's ~20 N ground force drawn 20 cm long
 # /physics: contact-point speed of the ball and of the paper's model for the ball's own ω, how far the
 # ball's contact velocity is from the paper's and from rigid rolling, slip speed, gap, drive error |ω − ω_cmd|
 PHYSICS = ["actual_speed", "paper_speed", "paper_model_error", "rigid_model_error", "slip_speed", "gap",
@@ -114,7 +115,8 @@ def lift(terrain: CosineTerrain, p: np.ndarray, velocity_xy: np.ndarray) -> np.n
 
 def closed_loop(cfg: DictConfig, m: Model, paths: list[str]) -> dict[str, np.ndarray]:
     """The controller of eqs. (55)-(58) driving MuJoCo balls, every control step (system.dt) recorded:
-    ball centre, linear velocity, attitude (w, x, y, z), body angular velocity, and the commanded world ω."""
+    ball centre, linear velocity, attitude (w, x, y, z), body angular velocity, and the commanded world ω; and
+    every system.tf_dt each ball's terrain contact (ground_contacts)."""
     import mujoco
 
     from pipeline.robotics.mjcf import check_mujoco
@@ -135,11 +137,17 @@ def closed_loop(cfg: DictConfig, m: Model, paths: list[str]) -> dict[str, np.nda
     mujoco.mj_forward(mj_model, data)
     qpos, qvel = data.qpos.reshape(k, 7), data.qvel.reshape(k, 6)   # views, updated in place by mj_step
     out = {name: np.empty((steps + 1, k, size)) for name, size in
-           (("center", 3), ("velocity", 3), ("quat", 4), ("omega_body", 3), ("omega_command", 3))}
+           (("center", 3), ("velocity", 3), ("quat", 4), ("omega_body", 3), ("omega_command", 3),
+            ("contact_point", 3), ("contact_force", 3))}
+    ball_of_geom = {mj_model.geom(f"ball{b}").id: b for b in range(k)}
+    contacts_every = max(1, round(s.tf_dt / dt))   # drawn at the /tf rate: recorded there only (NaN between)
+    out["contact_point"][:], out["contact_force"][:] = np.nan, np.nan
     steer = m.gains.steering
     for i in range(steps + 1):
         out["center"][i], out["velocity"][i], out["quat"][i], out["omega_body"][i] = \
             qpos[:, :3], qvel[:, :3], qpos[:, 3:], qvel[:, 3:]
+        if i % contacts_every == 0:
+            out["contact_point"][i], out["contact_force"][i] = ground_contacts(mj_model, data, ball_of_geom)
         state[:, :3] = contact_point(m.terrain, qpos[:, :3], radius, state[:, :3], iterations=3)
         c = controls(m, state, p_d[i], v_d[i])
         omega = shell_angular_velocity(c, radius)
@@ -153,6 +161,28 @@ def closed_loop(cfg: DictConfig, m: Model, paths: list[str]) -> dict[str, np.nda
         state[steer, 4] = np.clip(state[steer, 4], -m.tilt_limit, m.tilt_limit)
     check_mujoco(data, out["center"].reshape(len(t), -1), t)
     return out | {"t": t, "p_d": p_d, "p_d_dot": p_d_dot, "xml": xml}
+
+
+def ground_contacts(mj_model, data, ball_of_geom: dict[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """Per ball, MuJoCo's terrain contact: the mean contact position and the total force on the ball (world
+    frame, N); NaN position and zero force for a ball in the air."""
+    import mujoco
+
+    k = len(ball_of_geom)
+    points, forces, count = np.zeros((k, 3)), np.zeros((k, 3)), np.zeros(k)
+    wrench = np.zeros(6)
+    for i in range(data.ncon):
+        con = data.contact[i]
+        ball = ball_of_geom.get(con.geom2, ball_of_geom.get(con.geom1))
+        if ball is None or con.efc_address < 0:
+            continue
+        mujoco.mj_contactForce(mj_model, data, i, wrench)
+        f = con.frame.reshape(3, 3).T @ wrench[:3]   # on geom2, along the normal from geom1 to geom2
+        forces[ball] += f if con.geom2 in ball_of_geom else -f
+        points[ball] += con.pos
+        count[ball] += 1
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return points / count[:, None], forces
 
 
 def rolling_check(terrain: CosineTerrain, ball: dict, radius: float) -> dict[str, np.ndarray]:
@@ -218,6 +248,11 @@ def physics_check(cfg: DictConfig) -> list[Case]:
         log.log_transforms(ball["t"][tf], "world", ["sphere", "kinematic_model/sphere", "target"], frames)
         qpos = np.concatenate([ball["center"][tf], ball["quat"][tf]], axis=-1)  # every ball's free joint
         log.log_robot(ball["t"][tf], qpos.reshape(len(qpos), -1))
+        touching = np.isfinite(ball["contact_point"][tf, k]).all(axis=1)
+        log.log_contacts(ball["t"][tf], [p[None] if c else np.zeros((0, 3)) for p, c in
+                                         zip(ball["contact_point"][tf, k], touching, strict=True)],
+                         [f[None] if c else np.zeros((0, 3)) for f, c in
+                          zip(ball["contact_force"][tf, k], touching, strict=True)], CONTACT_SCALE, diameter=0.01)
         log_scene(log, m.terrain, s.radius, {"sphere": SHELL_COLOR, "kinematic_model/sphere": GHOST_COLOR})
 
     return [Case(f"{c}-{q}", lambda log, k=k: simulate_case(log, k)) for k, (c, q) in enumerate(pairs)]

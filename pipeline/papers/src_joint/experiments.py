@@ -33,8 +33,10 @@ from pipeline.papers.src_joint.physics import (
     roll_in_mujoco,
 )
 from pipeline.papers.src_joint.rolling import RollingChain
+from pipeline.robotics.transforms import quaternion_wxyz
 
 AXES = ["x", "y", "z"]
+CONTACT_SCALE = 0.01   # m/N: the joint's normal force drawn 1 cm per newton
 EULER = ["X", "Y", "Z"]   # intrinsic XYZ Euler angles (MATLAB rotm2eul(·, 'XYZ'), the paper's Figs. 9, 13, 14)
 
 
@@ -174,8 +176,16 @@ def joint_model(cfg: DictConfig) -> list[Case]:
             log.log_series("/command", t, kind="torque", name=AXES, value=plant.torque)
             log.log_series("/contact", t, schemas.Scalars, value=plant.contact,
                            name=["penetration", "normal_force", "friction_force"])
-        log.log_transforms(t, "world", ["B0", "B1", "B1_model", "P1"], _joint_pose_frames(plant, model, lower, upper))
-        log_spheres(log, ["B0", "B1", "B1_model"], [lower, upper, upper], [BASE_COLOR, LINK_COLOR, GHOST_COLOR])
+        frames = _joint_pose_frames(plant, model, lower, upper)
+        log.log_transforms(t, "world", ["B0", "B1", "B1_model", "P1"], frames)
+        if xml:  # the simulated pair drawn from its MuJoCo model (B1 on its free joint), the model's B1 beside it
+            log.log_robot(t, np.concatenate([frames[:, 1, :3, 3], quaternion_wxyz(frames[:, 1, :3, :3])], axis=1))
+            log_spheres(log, ["B1_model"], [upper], [GHOST_COLOR])
+            normal_force = plant.contact[:, 1]
+            log.log_contacts(t, frames[:, 3, None, :3, 3], (normal_force[:, None] * frames[:, 3, :3, 2])[:, None],
+                             CONTACT_SCALE, diameter=0.002)
+        else:
+            log_spheres(log, ["B0", "B1", "B1_model"], [lower, upper, upper], [BASE_COLOR, LINK_COLOR, GHOST_COLOR])
 
     return [Case(f"{plant}-{variant}", lambda log, p=plant, v=variant: simulate(log, p, v))
             for plant in sc.plants for variant in sc.variants]

@@ -128,23 +128,15 @@ def human_frame_names(arms: HumanArms) -> list[str]:
     return [f"human{k + 1}/{part}" for k in range(len(arms.base)) for part in ("upper", "fore")]
 
 
-def log_scene(log: RunWriter, cfg: DictConfig, arms: HumanArms, g: Geometry) -> None:
-    """One `/markers` message at t = 0: the arm's link capsules, its safety volume (translucent cones and the
-    elbow sphere) and the human capsules, each locked to its /tf frame; and the fixed world -> base turn."""
-    r, vol = cfg.system.dynamics.link_radius, cfg.system.safety
-    grey, orange = (0.45, 0.45, 0.5, 1.0), (0.95, 0.55, 0.15, 1.0)
-    safety, skin = (0.2, 0.6, 1.0, 0.18), (0.85, 0.6, 0.45, 1.0)
-    entities = [markers.capsule("column", "base", [0, 0, 0], [0, g.a0, 0], r, grey),
-                markers.capsule("upper_arm", "link3", [0, 0, 0], [g.a1, 0, 0], r, orange),
-                markers.capsule("forearm", "link5", [0, 0, 0], [g.a2, 0, 0], r, orange),
-                markers.capsule("tool", "link7", [0, 0, 0], [g.a3, 0, 0], 0.6 * r, grey),
-                markers.cone("safety/upper_arm", "link3", [0, 0, 0], [g.a1, 0, 0], vol.d_cmin, vol.d_cmax, safety),
+def log_scene(log: RunWriter, cfg: DictConfig, g: Geometry) -> None:
+    """One `/markers` message at t = 0: the arm's safety volume (translucent cones and the elbow sphere), locked
+    to its /tf frames (the arm and the human arms are drawn from the replay model's URDF); and the fixed
+    world -> base turn."""
+    vol = cfg.system.safety
+    safety = (0.2, 0.6, 1.0, 0.18)
+    entities = [markers.cone("safety/upper_arm", "link3", [0, 0, 0], [g.a1, 0, 0], vol.d_cmin, vol.d_cmax, safety),
                 markers.cone("safety/forearm", "link5", [0, 0, 0], [g.a2, 0, 0], vol.d_cmax, vol.d_cmin, safety),
                 *markers.spheres(["link4"], [vol.d_cmax], [safety])]
-    lengths = np.tile([arms.upper_length, arms.fore_length], len(arms.base))
-    radii = np.tile(arms.radius, len(arms.base))
-    entities += [markers.capsule(frame, frame, [0, 0, 0], [0, 0, length], radius, skin)
-                 for frame, length, radius in zip(human_frame_names(arms), lengths, radii, strict=True)]
     log.write("/markers", 0, schemas.SceneUpdate(entities=entities))
     log.log_transforms(np.zeros(1), "world", ["base"], WORLD_BASE[None, None])
 
@@ -278,6 +270,7 @@ def replay(log: RunWriter, cfg: DictConfig, times: np.ndarray, plan: planner.Pla
     at_samples = np.clip(np.rint(times / rp.dt).astype(int) - 1, 0, len(states) - 1)
     start, end, _ = capsules
     log_frames(log, times, states[at_samples, 1:8], g, plan.poses, start, end, arms)
+    log.log_robot(times, states[at_samples, 1:8], *mujoco_replay.mocap_poses(start, end))   # humans: mocap
     # MuJoCo's distance query on the same capsules: at the planned joints and at the executed ones
     names = pair_names(arms)
     planned = mujoco_replay.capsule_distances(xml, plan.q, start, end)
@@ -296,7 +289,7 @@ def _simulate(log: RunWriter, cfg: DictConfig, case: str, replayed: bool) -> Non
     log_plan(log, cfg, times, plan, points, capsules, arms)
     log.log_series("/reference/tool", times, schemas.Reference, name=XYZ, position=plan.poses[:, :3, 3])
     if replayed:
-        log_scene(log, cfg, arms, geometry(cfg))
+        log_scene(log, cfg, geometry(cfg))
         log_collision_points(log, times, plan, cfg.system.filter.dt)
         replay(log, cfg, times, plan, capsules, arms)
     else:
