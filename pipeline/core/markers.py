@@ -123,3 +123,49 @@ def contacts(name: str, points: np.ndarray, forces: np.ndarray, scale: float, fr
         frame_id=frame, id=name, frame_locked=True,
         spheres=[_ball(p, diameter, color) for p in points],
         arrows=[_arrow(p, f, color, diameter) for p, f in zip(points, forces, strict=True) if f.any()])
+
+
+def _cube(centre, quat_wxyz, size: Sequence[float], color) -> schemas.CubePrimitive:
+    return schemas.CubePrimitive(pose=_pose(centre, quat_wxyz), color=_color(color),
+                                 size=schemas.Vector3(x=float(size[0]), y=float(size[1]), z=float(size[2])))
+
+
+def _z_axis(quat_wxyz: Sequence[float]) -> np.ndarray:
+    """The local z axis of a unit quaternion's frame."""
+    w, x, y, z = quat_wxyz
+    return np.array([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
+
+
+def mujoco_geoms(model, bodies: Sequence[str] | None = None, plane_size: float = 4.0) -> list:
+    """The geoms of a compiled MuJoCo model (of the named `bodies` only, if given), one entity per body in the /tf
+    frame named as the body (`world` for the world body's): boxes as cubes, spheres, cylinders, capsules as a
+    cylinder with two end spheres, planes as a thin `plane_size` square slab whose top is the plane. Log the
+    bodies' poses on /tf under the same names."""
+    import mujoco
+
+    box, sphere, cylinder, capsule_, plane = (int(k) for k in (
+        mujoco.mjtGeom.mjGEOM_BOX, mujoco.mjtGeom.mjGEOM_SPHERE, mujoco.mjtGeom.mjGEOM_CYLINDER,
+        mujoco.mjtGeom.mjGEOM_CAPSULE, mujoco.mjtGeom.mjGEOM_PLANE))
+    wanted = None if bodies is None else {mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in bodies}
+    entities: dict[int, schemas.SceneEntity] = {}
+    for g in range(model.ngeom):
+        body = int(model.geom_bodyid[g])
+        if wanted is not None and body not in wanted:
+            continue
+        frame = "world" if body == 0 else mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body)
+        entity = entities.setdefault(body, schemas.SceneEntity(frame_id=frame, id=f"geoms/{frame}",
+                                                               frame_locked=True))
+        kind, size, pos, quat = int(model.geom_type[g]), model.geom_size[g], model.geom_pos[g], model.geom_quat[g]
+        color = model.geom_rgba[g]
+        if kind == box:
+            entity.cubes.append(_cube(pos, quat, 2 * size, color))
+        elif kind == sphere:
+            entity.spheres.append(_ball(pos, size[0], color))
+        elif kind in (cylinder, capsule_):
+            half = size[1] * _z_axis(quat)
+            entity.cylinders.append(_cylinder(pos - half, pos + half, size[0], size[0], color))
+            if kind == capsule_:
+                entity.spheres.extend(_ball(end, size[0], color) for end in (pos - half, pos + half))
+        elif kind == plane:
+            entity.cubes.append(_cube(pos - 0.001 * _z_axis(quat), quat, (plane_size, plane_size, 0.002), color))
+    return list(entities.values())
