@@ -38,10 +38,13 @@ CONF_DIR = Path(__file__).resolve().parents[2] / "conf"
 
 @dataclass(frozen=True)
 class Case:
-    """One run of an experiment: `simulate` writes its records into the open run file."""
+    """One run of an experiment: `simulate` writes its records into the open run file. A case whose
+    simulation `shares_work` with the experiment's other cases (all simulated together on the first one's
+    turn) keeps them in one process."""
 
     id: str
     simulate: Callable[[RunWriter], None]
+    shares_work: bool = False
 
 
 ExperimentFn = Callable[[DictConfig], list[Case]]

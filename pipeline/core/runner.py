@@ -78,7 +78,8 @@ def simulate(cfg: DictConfig, experiment_id: str, overrides: list[str] | None = 
     common = {"slug": slug, "experiment": name, "seed": str(cfg.seed), "params": params,
               "git_revision": provenance.git_revision(), "package_versions": provenance.package_versions(),
               "machine": provenance.machine()}
-    workers = 1 if experiment.timed else min(worker_count(cfg.get("workers", 0)), len(cases))
+    alone = experiment.timed or any(case.shares_work for case in cases)
+    workers = 1 if alone else min(worker_count(cfg.get("workers", 0)), len(cases))
     common["parallel_runs"] = str(workers)  # a compute time logged beside other runs says so
     jobs = [(case, rid, out_dir, config_yaml, {**common, "run_id": rid, "case": case.id})
             for case, rid in zip(cases, ids, strict=True)]

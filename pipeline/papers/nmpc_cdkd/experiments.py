@@ -383,4 +383,5 @@ def compute_time(cfg: DictConfig) -> list[Case]:
             log_trajectory(log, arm, tr, combo[0], obstacles, ["obstacle"], offset - float(tr.t[0]), index, untimed)
             offset += float(tr.t[-1] - tr.t[0]) + cfg.system.dt
 
-    return [Case(f"{model}-{case}-k{k}", lambda log, c=(model, case, k): simulate(log, c)) for model, case, k in combos]
+    return [Case(f"{model}-{case}-k{k}", lambda log, c=(model, case, k): simulate(log, c), shares_work=True)
+            for model, case, k in combos]

@@ -180,7 +180,7 @@ def tuning_cases(cfg: DictConfig, tunings: list[tuple[str, float, float, float]]
             raise SimulationFailed(failure)
         log_closed_loop(log, cfg, arm, motion_of(cfg, arm), run, law)
 
-    return [Case(cid, lambda log, c=cid: simulate(log, c)) for cid, *_ in tunings]
+    return [Case(cid, lambda log, c=cid: simulate(log, c), shares_work=True) for cid, *_ in tunings]
 
 
 # -- E1: the set-point motion, Figs. 4-5 ------------------------------------------------------------------
