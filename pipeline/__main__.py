@@ -1,7 +1,8 @@
 """Simulate stage CLI (a Hydra app: `--help` lists every experiment, `--cfg job`, `-p KEY`, `-m` as documented).
 
     python -m pipeline experiment=<slug>/<name> [key=value ...]       one experiment, one MCAP per case
-    python -m pipeline -m experiment=<slug>/<name> key=a,b,c           a sweep, run in parallel (joblib)
+    python -m pipeline -m experiment=<slug>/<name> key=a,b,c           a sweep, run in parallel (joblib), into
+                                                                       <data_dir>/sweeps/<time>/ (sweep_dir=...)
     python -m pipeline --help                                          every experiment, one line each
     python -m pipeline experiment=<slug>/<name> --cfg job              the resolved config, nothing run
 """
@@ -33,7 +34,8 @@ def main() -> None:
 
     import hydra
     from hydra.core.hydra_config import HydraConfig
-    from omegaconf import DictConfig
+    from hydra.types import RunMode
+    from omegaconf import DictConfig, open_dict
 
     from pipeline.core import interrupts
     from pipeline.core.experiment import CONF_DIR
@@ -48,6 +50,10 @@ def main() -> None:
         if worker:  # a sweep worker must not outlive the stage that started it
             interrupts.die_with_parent()
         hc = HydraConfig.get()
+        if hc.mode == RunMode.MULTIRUN:   # the sweep's own folder; its launcher draws the one progress bar
+            with open_dict(cfg):
+                sweep_dir = cfg.sweep_dir   # resolved before data_dir, which it names, changes
+                cfg.data_dir, cfg.sweep_dir, cfg.progress = sweep_dir, sweep_dir, False
         try:
             errors = simulate(cfg, hc.runtime.choices["experiment"], list(hc.overrides.task))
         except BadInput as err:

@@ -20,7 +20,7 @@ from pipeline.core.files import Busy, Locks, stale_partials
 from pipeline.core.runlog import CONFIG_ATTACHMENT, RunWriter, SimulationFailed
 
 # Overrides that do not change what is simulated, so they do not name a run.
-NOT_PARAMS = ("experiment", "data_dir", "progress")
+NOT_PARAMS = ("experiment", "data_dir", "sweep_dir", "progress")
 MAX_ID = 120
 
 
