@@ -66,6 +66,12 @@ def main() -> None:
         if errors:
             raise SystemExit(1)
 
+    # Hydra 1.3 cannot scan an editable install's hydra_plugins: our launcher is registered by hand
+    from hydra.core.plugins import Plugins
+
+    from hydra_plugins.robotics_repro.submitit_chunks import SubmititChunks
+
+    Plugins.instance().register(SubmititChunks)
     interrupts.install()
     try:
         task()

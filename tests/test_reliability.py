@@ -230,7 +230,8 @@ def test_ctrl_c_during_an_exudyn_run_stops_the_stage(tmp_path):
 def test_killing_a_sweep_leaves_no_orphan(tmp_path):
     data_dir = tmp_path / "data"
     proc = subprocess.Popen([sys.executable, "-m", "pipeline", "-m", "experiment=ur5-ik-fsm/singular-paths",
-                             "execute.bandwidth_hz=4,6,8,10", f"data_dir={data_dir}", "progress=false"],
+                             "execute.bandwidth_hz=4,6,8,10", f"data_dir={data_dir}", f"sweep_dir={data_dir}",
+                             "progress=false"],
                             cwd=ROOT, env=ENV, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 120
     out = data_dir / "runs/ur5-ik-fsm/singular-paths"

@@ -18,7 +18,8 @@ def test_setpoint_and_a_maps_sweep_to_report(data_dir):
     proc = run_cli("pipeline", f"experiment={SLUG}/setpoint", f"data_dir={data_dir}", "progress=false")
     assert proc.returncode == 0, proc.stderr
     # a real multirun (joblib): two grid points, shortened to the first move
-    proc = run_cli("pipeline", "-m", f"experiment={SLUG}/maps", f"data_dir={data_dir}", "progress=false",
+    proc = run_cli("pipeline", "-m", f"experiment={SLUG}/maps", f"data_dir={data_dir}", f"sweep_dir={data_dir}",
+                   "progress=false",
                    "scenario.d_xyz=4000,5000", "scenario.k_xyz=80000", "scenario.duration=0.5")
     assert proc.returncode == 0, proc.stderr
     proc = run_cli("analysis", f"data_dir={data_dir}")

@@ -380,6 +380,7 @@ def write_summary(evaluated: pd.DataFrame, summary_dir: Path) -> None:
                                pipeline_value=pd.to_numeric(evaluated["pipeline_value"], errors="coerce"))
     numbers = numbers[(numbers["mode"] != "consistency") & numbers["paper_value"].notna()
                       & numbers["pipeline_value"].notna()]
+    paper = numbers["paper_value"].where(numbers["paper_value"] != 0)
     numbers = numbers.assign(target=numbers["slug"] + "/" + numbers["target_id"],
-                             ratio=numbers["pipeline_value"] / numbers["paper_value"].where(numbers["paper_value"] != 0))
+                             ratio=numbers["pipeline_value"] / paper)
     files.write_text(summary_dir / "comparison.csv", numbers[SUMMARY_COLUMNS].to_csv(index=False))
