@@ -69,9 +69,11 @@ def main() -> None:
     # Hydra 1.3 cannot scan an editable install's hydra_plugins: our launcher is registered by hand
     from hydra.core.plugins import Plugins
 
+    from hydra_plugins.robotics_repro.joblib_bar import JoblibBar
     from hydra_plugins.robotics_repro.submitit_chunks import SubmititChunks
 
-    Plugins.instance().register(SubmititChunks)
+    for plugin in (JoblibBar, SubmititChunks):
+        Plugins.instance().register(plugin)
     interrupts.install()
     try:
         task()

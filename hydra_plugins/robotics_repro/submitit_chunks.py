@@ -82,7 +82,7 @@ class SubmititChunks(Launcher):
         jobs = self._executor(submitit).map_array(self, chunks, [Singleton.get_state()] * len(chunks))
         size = {job.job_id: len(chunk) for job, chunk in zip(jobs, chunks, strict=True)}
         show = OmegaConf.select(self.config, "progress", default=True)
-        with tqdm(total=len(points), desc="sweep", unit="run", disable=None if show else True) as bar:
+        with tqdm(total=len(points), desc="sweep", unit="point", disable=None if show else True) as bar:
             for job in submitit.helpers.as_completed(jobs, poll_frequency=POLL_S[self.executor]):
                 bar.update(size[job.job_id])
         return [ret for job in jobs for ret in job.results()[0]]
