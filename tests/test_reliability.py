@@ -113,7 +113,7 @@ def test_every_size_step_and_choice_is_declared(experiment_id):
     defaults = compose_config([f"experiment={experiment_id}"])
     unguarded = []
     for key, value in _leaves(defaults):
-        if key.startswith("hydra") or key in ("data_dir", "seed", "progress", "description"):
+        if key.startswith("hydra") or key in ("data_dir", "sweep_dir", "seed", "progress", "description"):
             continue
         last = re.sub(r"\[\d+\]", "", key).rsplit(".", 1)[-1]
         if isinstance(value, str):
