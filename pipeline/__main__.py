@@ -1,7 +1,8 @@
 """Simulate stage CLI (a Hydra app: `--help` lists every experiment, `--cfg job`, `-p KEY`, `-m` as documented).
 
     python -m pipeline experiment=<slug>/<name> [key=value ...]       one experiment, one MCAP per case
-    python -m pipeline -m experiment=<slug>/<name> key=a,b,c           a sweep, run in parallel (joblib)
+    python -m pipeline -m experiment=<slug>/<name> key=a,b,c           a sweep, run in parallel (joblib), into
+                                                                       <data_dir>/sweeps/<time>/ (sweep_dir=...)
     python -m pipeline --help                                          every experiment, one line each
     python -m pipeline experiment=<slug>/<name> --cfg job              the resolved config, nothing run
 """
@@ -36,7 +37,7 @@ def main() -> None:
     import hydra
     from hydra.core.hydra_config import HydraConfig
     from hydra.types import RunMode
-    from omegaconf import DictConfig
+    from omegaconf import DictConfig, open_dict
 
     from pipeline.core import interrupts
     from pipeline.core.experiment import CONF_DIR
@@ -51,8 +52,10 @@ def main() -> None:
         if worker:  # a sweep worker must not outlive the stage that started it
             interrupts.die_with_parent()
         hc = HydraConfig.get()
-        if hc.mode == RunMode.MULTIRUN:  # the launcher already runs one job per core
-            cfg.workers = 1
+        if hc.mode == RunMode.MULTIRUN:   # the sweep's own folder; its launcher draws the one progress bar
+            with open_dict(cfg):          # and runs one job per core, so each job runs its cases itself
+                sweep_dir = cfg.sweep_dir   # resolved before data_dir, which it names, changes
+                cfg.data_dir, cfg.sweep_dir, cfg.progress, cfg.workers = sweep_dir, sweep_dir, False, 1
         try:
             errors = simulate(cfg, hc.runtime.choices["experiment"], list(hc.overrides.task))
         except BadInput as err:
@@ -64,6 +67,15 @@ def main() -> None:
             raise
         if errors:
             raise SystemExit(1)
+
+    # Hydra 1.3 cannot scan an editable install's hydra_plugins: our launcher is registered by hand
+    from hydra.core.plugins import Plugins
+
+    from hydra_plugins.robotics_repro.joblib_bar import JoblibBar
+    from hydra_plugins.robotics_repro.submitit_chunks import SubmititChunks
+
+    for plugin in (JoblibBar, SubmititChunks):
+        Plugins.instance().register(plugin)
 
     from pipeline.core import stages
 

@@ -71,7 +71,9 @@ def test_sweep_runs_one_file_per_point_in_parallel(data_dir):
                    "scenario.algorithms=[alg2]", "execute.bandwidth_hz=6,10", f"data_dir={data_dir}")
     assert proc.returncode == 0, proc.stderr
     assert "LokyBackend with 2 concurrent workers" in proc.stderr  # joblib: parallel processes
-    runs = [read_run(p) for p in run_files(data_dir / "runs/ur5-ik-fsm/singular-paths")]
+    (sweep,) = (data_dir / "sweeps").iterdir()                       # its own folder, named by its start time
+    assert not (data_dir / "runs").exists()
+    runs = [read_run(p) for p in run_files(sweep / "runs/ur5-ik-fsm/singular-paths")]
     assert sorted(r.params["execute.bandwidth_hz"] for r in runs) == ["10", "6"]
     assert all(r.ok for r in runs) and len({r.run_id for r in runs}) == 2
 
@@ -80,10 +82,10 @@ def test_a_sweep_on_two_local_ray_workers(data_dir):
     pytest.importorskip("hydra_plugins.hydra_ray_launcher", reason="the [ray] extra is not installed")
     proc = run_cli("pipeline", "-m", "experiment=ur5-ik-fsm/singular-paths", *SHORT_PATH, "scenario.algorithms=[alg2]",
                    "execute.bandwidth_hz=6,10", "hydra/launcher=ray", "+hydra.launcher.ray.init.num_cpus=2",
-                   f"data_dir={data_dir}", timeout=600)
+                   f"data_dir={data_dir}", f"sweep_dir={data_dir}/sweeps/ray", timeout=600)
     assert proc.returncode == 0, proc.stderr
     assert "is validated against ConfigStore schema" not in proc.stderr  # no deprecation noise from our config
-    runs = [read_run(p) for p in run_files(data_dir / "runs/ur5-ik-fsm/singular-paths")]
+    runs = [read_run(p) for p in run_files(data_dir / "sweeps/ray/runs/ur5-ik-fsm/singular-paths")]
     assert sorted(r.params["execute.bandwidth_hz"] for r in runs) == ["10", "6"] and all(r.ok for r in runs)
 
 

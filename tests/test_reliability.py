@@ -113,7 +113,7 @@ def test_every_size_step_and_choice_is_declared(experiment_id):
     defaults = compose_config([f"experiment={experiment_id}"])
     unguarded = []
     for key, value in _leaves(defaults):
-        if key.startswith("hydra") or key in ("data_dir", "seed", "progress", "description"):
+        if key.startswith("hydra") or key in ("data_dir", "sweep_dir", "seed", "progress", "description"):
             continue
         last = re.sub(r"\[\d+\]", "", key).rsplit(".", 1)[-1]
         if isinstance(value, str):
@@ -259,7 +259,8 @@ def test_ctrl_c_during_an_exudyn_run_stops_the_stage(tmp_path):
 def test_killing_a_sweep_leaves_no_orphan(tmp_path):
     data_dir = tmp_path / "data"
     proc = subprocess.Popen([sys.executable, "-m", "pipeline", "-m", "experiment=ur5-ik-fsm/singular-paths",
-                             "execute.bandwidth_hz=4,6,8,10", f"data_dir={data_dir}", "progress=false"],
+                             "execute.bandwidth_hz=4,6,8,10", f"data_dir={data_dir}", f"sweep_dir={data_dir}",
+                             "progress=false"],
                             cwd=ROOT, env=ENV, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 120
     out = data_dir / "runs/ur5-ik-fsm/singular-paths"

@@ -20,12 +20,13 @@ def test_setpoint_and_a_maps_sweep_to_report(data_dir):
     proc = run_cli("pipeline", f"experiment={SLUG}/setpoint", f"data_dir={data_dir}", "progress=false")
     assert proc.returncode == 0, proc.stderr
     # a real multirun (joblib) over the stiffness, each job a 2 × 2 grid simulated together, shortened
-    proc = run_cli("pipeline", "-m", f"experiment={SLUG}/maps", f"data_dir={data_dir}", "progress=false",
-                   "scenario.d_xyz=[4000,5000]", "scenario.hd_xyz=[0,8500]", "scenario.k_xyz=80000,10000",
-                   "scenario.duration=0.5", "execute.log_dt=0.0025")
+    proc = run_cli("pipeline", "-m", f"experiment={SLUG}/maps", f"data_dir={data_dir}", f"sweep_dir={data_dir}",
+                   "progress=false", "scenario.d_xyz=[4000,5000]", "scenario.hd_xyz=[0,8500]",
+                   "scenario.k_xyz=80000,10000", "scenario.duration=0.5", "execute.log_dt=0.0025")
     assert proc.returncode == 0, proc.stderr
     # a sensitivity sweep point: its runs and aggregates carry the sweep's suffix
-    proc = run_cli("pipeline", "-m", f"experiment={SLUG}/maps-sensitivity", f"data_dir={data_dir}", "progress=false",
+    proc = run_cli("pipeline", "-m", f"experiment={SLUG}/maps-sensitivity", f"data_dir={data_dir}",
+                   f"sweep_dir={data_dir}", "progress=false",
                    "scenario.d_xyz=[4000,5000]", "scenario.hd_xyz=[0,8500]", "scenario.k_xyz=[80000]",
                    "scenario.duration=0.5", "system.control.implementation=continuous", "execute.log_dt=0.0025")
     assert proc.returncode == 0, proc.stderr

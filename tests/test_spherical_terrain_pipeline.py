@@ -14,7 +14,7 @@ def test_paths_and_a_short_physics_check_to_report(data_dir):
                  ["experiment=spherical-terrain/physics-check", "system.duration=2", "scenario.classes=[rt,rs]"],
                  ["-m", "experiment=spherical-terrain/gain-search", "scenario.paths=[diamond]",
                   "system.controller.class_rs.k_alpha=1,4"]):
-        proc = run_cli("pipeline", *args, f"data_dir={data_dir}", "progress=false")
+        proc = run_cli("pipeline", *args, f"data_dir={data_dir}", f"sweep_dir={data_dir}", "progress=false")
         assert proc.returncode == 0, proc.stderr
     proc = run_cli("analysis", f"data_dir={data_dir}")         # every experiment with runs, then the report
     assert proc.returncode == 0, proc.stderr

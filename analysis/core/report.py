@@ -7,6 +7,10 @@
                                                 itself, runs and the commands that regenerate them, the paper's
                                                 report sections, assumptions, errata
     <data_dir>/report/targets.csv               every target: TARGETS_CSV_COLUMNS (below)
+    <data_dir>/summary/status.json              DVC metrics: per paper (and `all`), targets per status (`not run`
+                                                as not_run) and self-consistency checks; `dvc metrics diff`
+    <data_dir>/summary/comparison.csv           DVC plots: every target with a number on both sides,
+                                                paper_value vs pipeline_value (SUMMARY_COLUMNS); `dvc plots show`
 
 Pages are rendered from the Jinja2 templates in analysis/core/templates/: HTML escapes every value by
 construction, Markdown cells go through the `cell` filter (a `|` or a line break cannot break a row).
@@ -47,6 +51,7 @@ The columns of targets.csv (one row per target of every paper):
 from __future__ import annotations
 
 import fnmatch
+import json
 import math
 import os
 import re
@@ -68,6 +73,7 @@ from pipeline.core import files, provenance
 TARGETS_CSV_COLUMNS = ["slug", "target_id", "category", "quantity", "where", "paper_value", "op", "pipeline_value",
                        "band_min", "band_max", "deviation", "relative_deviation", "unit", "mode", "basis",
                        "tolerance", "status", "cause", "note", "experiment", "run"]
+SUMMARY_COLUMNS = ["target", "slug", "quantity", "unit", "paper_value", "pipeline_value", "ratio", "status"]
 FURTHER = "further results"
 SELF_STATUSES = ("agrees", "disagrees", "not run")
 ROOT = Path(__file__).resolve().parents[2]
@@ -357,3 +363,24 @@ def write_targets_csv(evaluated: list[pd.DataFrame], path: Path) -> pd.DataFrame
     frame = frame[TARGETS_CSV_COLUMNS]
     files.write_text(path, frame.to_csv(index=False))
     return frame
+
+
+def write_summary(evaluated: pd.DataFrame, summary_dir: Path) -> None:
+    """What DVC tracks across commits: status counts per paper as metrics, and paper vs pipeline values as plots."""
+    def counts(frame: pd.DataFrame) -> dict[str, int]:
+        reproduced = frame[frame["mode"] != "consistency"]["status"].value_counts()
+        checks = frame[frame["mode"] == "consistency"]["status"].value_counts()
+        return {**{s.replace(" ", "_"): int(reproduced.get(s, 0)) for s in STATUSES},
+                "self_consistency": {s.replace(" ", "_"): int(checks.get(s, 0)) for s in SELF_STATUSES}}
+
+    status = {slug: counts(frame) for slug, frame in evaluated.groupby("slug")}
+    status["all"] = counts(evaluated)
+    files.write_text(summary_dir / "status.json", json.dumps(status, indent=2) + "\n")
+    numbers = evaluated.assign(paper_value=pd.to_numeric(evaluated["paper_value"], errors="coerce"),
+                               pipeline_value=pd.to_numeric(evaluated["pipeline_value"], errors="coerce"))
+    numbers = numbers[(numbers["mode"] != "consistency") & numbers["paper_value"].notna()
+                      & numbers["pipeline_value"].notna()]
+    paper = numbers["paper_value"].where(numbers["paper_value"] != 0)
+    numbers = numbers.assign(target=numbers["slug"] + "/" + numbers["target_id"],
+                             ratio=numbers["pipeline_value"] / paper)
+    files.write_text(summary_dir / "comparison.csv", numbers[SUMMARY_COLUMNS].to_csv(index=False))

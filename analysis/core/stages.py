@@ -100,14 +100,18 @@ def write_report(data_dir: Path) -> tuple[Path, list[str]]:
         metrics = read_metrics(sorted(metrics_dir.glob("*.parquet")))
         runs = _runs_table(metrics_dir)
         evaluated = evaluate(slug, load_targets(package_dir / "targets.csv"), metrics, runs)
-        sections = package.report_sections(metrics, runs) if hasattr(package, "report_sections") and metrics else []
+        try:
+            sections = package.report_sections(metrics, runs) if hasattr(package, "report_sections") and metrics else []
+        except Exception as err:  # one paper's extra tables must not cost the report: its page goes without them
+            sections = []
+            problems.append(f"{slug}: its report sections failed: {type(err).__name__}: {err}")
         figures = sorted((data_dir / "figures" / slug).glob("*/*.png"))
         report.write_paper_pages(report_dir, report.paper_context(info, evaluated, runs, sections, figures,
                                                                   data_dir, report_dir))
         pages.append((info, evaluated, runs))
         all_evaluated.append(evaluated)
         problems += report.undeclared_bands(info, evaluated) + self_check(evaluated)
-    report.write_targets_csv(all_evaluated, report_dir / "targets.csv")
+    report.write_summary(report.write_targets_csv(all_evaluated, report_dir / "targets.csv"), data_dir / "summary")
     return report.write_index(report_dir, report.index_context(pages)), problems
 
 

@@ -42,6 +42,10 @@ from pipeline.core.experiment import (
 
 NO_PREFLIGHT_FLAGS = {"--help", "-h", "--hydra-help", "--info", "-i", "--shell-completion", "-sc"}
 SWEEP_LIMIT = 10_000
+# launchers that need an optional extra: the plugin module it installs, and the extra's name
+LAUNCHER_EXTRAS = {"ray": ("hydra_plugins.hydra_ray_launcher", "ray"),
+                   "slurm": ("hydra_plugins.hydra_submitit_launcher", "slurm"),
+                   "slurm_local": ("hydra_plugins.hydra_submitit_launcher", "slurm")}
 SAFE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._=,+-]{0,199}")
 
 
@@ -283,9 +287,10 @@ def preflight(argv: list[str]) -> None:
             hint = difflib.get_close_matches(experiment_id, known, n=1)
             raise BadInput(f"unknown experiment '{experiment_id}'"
                            + (f" (did you mean '{hint[0]}'?)" if hint else f"; {_listing(known)}"))
-        if any(o.replace(" ", "") == "hydra/launcher=ray" for o in extra) and \
-                importlib.util.find_spec("hydra_plugins.hydra_ray_launcher") is None:
-            raise BadInput("hydra/launcher=ray needs the Ray launcher: pip install -e '.[ray]'")
+        for launcher, (plugin, extra_name) in LAUNCHER_EXTRAS.items():
+            if any(o.replace(" ", "") == f"hydra/launcher={launcher}" for o in extra) and \
+                    importlib.util.find_spec(plugin) is None:
+                raise BadInput(f"hydra/launcher={launcher} needs its extra: pip install -e '.[{extra_name}]'")
         for o in extra:
             if o.startswith("+") and not o.startswith("+hydra"):
                 raise BadInput(f"adding keys is not allowed ('{o}'): every parameter has a default in conf/")

@@ -24,7 +24,7 @@ from pipeline.core.files import Busy, Locks, stale_partials
 from pipeline.core.runlog import CONFIG_ATTACHMENT, RunWriter, SimulationFailed
 
 # Overrides that do not change what is simulated, so they do not name a run.
-NOT_PARAMS = ("experiment", "data_dir", "progress", "workers")
+NOT_PARAMS = ("experiment", "data_dir", "sweep_dir", "progress", "workers")
 MAX_ID = 120
 
 

@@ -30,8 +30,8 @@ def report_sections(metrics: dict[str, pd.DataFrame], runs: pd.DataFrame) -> lis
              "(25) as printed the heading laws of 3R and RT turn them away from the target, and with eq. (58) as "
              "printed the RS-SR's tilt rolls it away sideways; 2R-SR (ψ ≡ 0) is unaffected. Eq. (60) as printed "
              "is a segment of the line y = x, traversed back and forth, so 'circle' here is that segment.")):
-        frame = metrics.get(name)
-        if frame is not None and not frame.empty:
+        frame = metrics.get(name)   # the default runs only: a sweep folder may hold none
+        if frame is not None and (~frame["run_id"].str.contains("__") & (frame["run_id"] != "all")).any():
             sections.append(Section(title, text, Table(_run_table(frame), ".4g"), category="tracking errors"))
     sweep = metrics.get("sweep")
     if sweep is not None and not sweep.empty:
