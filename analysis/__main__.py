@@ -2,6 +2,7 @@
 
     python -m analysis                                   every experiment with runs on disk, then the report
     python -m analysis experiment=<slug>/<name>          one experiment's metrics and figures, then the report
+    python -m analysis experiment=<slug>                 every experiment of one paper (a DVC analyze stage)
     python -m analysis stage=report                      only the report, from the metrics on disk
     python -m analysis data_dir=/elsewhere ...           where runs are read and outputs written (default data)
 
@@ -36,6 +37,7 @@ def parse(overrides: list[str]) -> dict[str, str | None]:
     if args["stage"] not in STAGES:
         raise ValueError(f"stage={args['stage']} must be one of {', '.join(STAGES)}")
     known = available_experiments()
+    known += sorted({e.split("/")[0] for e in known})  # a paper: all its experiments
     if args["experiment"] is not None and args["experiment"] not in known:
         hint = difflib.get_close_matches(args["experiment"], known, n=1)
         raise ValueError(f"unknown experiment '{args['experiment']}'"

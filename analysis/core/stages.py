@@ -116,11 +116,13 @@ def write_report(data_dir: Path) -> tuple[Path, list[str]]:
 
 
 def run(data_dir: Path, experiment: str | None, stage: str) -> int:
-    """Analyze the experiments that have runs, then write the report; 1 if nothing could be analysed, an
+    """Analyze the experiments that have runs (`experiment`: one `<slug>/<name>`, every experiment of a paper
+    `<slug>`, or None: all), then write the report; 1 if nothing could be analysed, an
     experiment's analysis failed (the others are still analysed) or the report's self-check found a problem
     (the report is still written, with every problem named on stderr)."""
-    experiments = [experiment] if experiment else [e for e in available_experiments()
-                                                   if e.split("/")[0] in analyzed_slugs()]
+    one = experiment is not None and "/" in experiment
+    experiments = [experiment] if one else [e for e in available_experiments() if e.split("/")[0] in analyzed_slugs()
+                                            and (experiment is None or e.split("/")[0] == experiment)]
     failed = 0
     if stage in ("analyze", "all"):
         analysed = 0
@@ -133,7 +135,7 @@ def run(data_dir: Path, experiment: str | None, stage: str) -> int:
                       f"{str(err).splitlines()[0] if str(err) else ''}"[:280], file=sys.stderr)
                 continue
             if out is None:
-                if experiment:
+                if one:
                     print(f"error: no runs under {data_dir / 'runs' / experiment_id}; "
                           f"run: python -m pipeline experiment={experiment_id} data_dir={data_dir}", file=sys.stderr)
                     return 1
