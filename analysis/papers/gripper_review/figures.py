@@ -20,7 +20,7 @@ def force_payload_figure(grippers: pd.DataFrame, gravity: float, figures: Figure
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.6), sharey=True)
     spread = np.linspace(-0.3, 0.3, len(ACTUATIONS))
     for ax, column, title in ((axes[0], "grasp_force", "grasp force"), (axes[1], "payload", "payload (weight)")):
-        quoted = grippers.dropna(subset=[f"{column}_n"])
+        quoted = grippers.dropna(subset=[f"{column}_n"]).sort_values(f"{column}_n")
         for actuation, rows in quoted.groupby("actuation"):
             x = rows["gripper_class"].map({c: i for i, c in enumerate(CLASSES)}) + spread[
                 ACTUATIONS.index(actuation)]
@@ -29,7 +29,7 @@ def force_payload_figure(grippers: pd.DataFrame, gravity: float, figures: Figure
             for k, (xi, row) in enumerate(zip(x, rows.itertuples(), strict=True)):
                 value = getattr(row, f"{column}_n")
                 bound = BOUND_MARKERS.get(getattr(row, f"{column}_qualifier"), "")
-                ax.annotate(f"[{row.ref}]{bound}", (xi, value), xytext=(5, 1 if k % 2 else -7),
+                ax.annotate(f"[{row.ref}]{bound}", (xi, value), xytext=(5, 2 if k % 2 else -8),
                             textcoords="offset points", fontsize=7)  # alternate: close values stay legible
         ax.set_xticks(range(len(CLASSES)), [c.replace(" ", "\n") for c in CLASSES])
         ax.set_xlim(-0.6, len(CLASSES) - 0.4)
