@@ -27,7 +27,7 @@ def analyze_dataset(runs: list[Run], figures: Figures) -> pd.DataFrame:
         checks = table3_checks(review)
         for key in [k for k in checks if k.endswith("payload_max")]:  # Table 3 prints loads as masses
             checks[f"{key}_mass"] = (checks[key][0] / gravity, "kg")
-        sizes, _ = table2_size_checks(review)
+        sizes = table2_size_checks(review)
         m.add_run(run, {**found, **checks, **sizes})
         for row in review.grippers.astype(object).where(review.grippers.notna(), None).itertuples():
             params = {"gripper": f"[{row.ref}] {row.name or ''}".strip(), "gripper_class": row.gripper_class or "",
@@ -38,7 +38,8 @@ def analyze_dataset(runs: list[Run], figures: Figures) -> pd.DataFrame:
                     m.add(f"ref-{row.ref}", f"{quantity}", value, "N",
                           {**params, "qualifier": getattr(row, f"{quantity}_qualifier")})
         data_dir = run.path.parents[3]   # <data_dir>/runs/<slug>/<experiment>/<run>.mcap
-        dataset.export(review, data_dir, load_paper_info(PACKAGE), run.config, found)
+        dataset.export(review, data_dir, load_paper_info(PACKAGE), run.config, found,
+                       run.metadata.get("git_revision", "unknown"))
         force_payload_figure(review.grippers, gravity, figures)
     return m.frame()
 

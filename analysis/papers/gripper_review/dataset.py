@@ -13,7 +13,6 @@
 
 from __future__ import annotations
 
-import subprocess
 from pathlib import Path
 
 import pandas as pd
@@ -51,22 +50,15 @@ def read_csv(path: Path) -> pd.DataFrame:
     return frame.astype({"ref": "int64"}) if "ref" in frame else frame
 
 
-def _revision() -> str:
-    try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=TEMPLATES, capture_output=True,
-                              text=True, timeout=10).stdout.strip() or "unknown"
-    except OSError:
-        return "unknown"
-
-
-def card(review: Review, info: dict, config: dict, counts: dict) -> str:
+def card(review: Review, info: dict, config: dict, counts: dict, revision: str) -> str:
     env = Environment(loader=FileSystemLoader(TEMPLATES), undefined=StrictUndefined, keep_trailing_newline=True)
     return env.get_template("card.md.j2").render(
         info=info, columns=COLUMNS, n_grippers=len(review.grippers), n_cells=len(review.cells), counts=counts,
-        config=config, revision=_revision(), tables=TABLES)
+        config=config, revision=revision, tables=TABLES)
 
 
-def export(review: Review, data_dir: Path, info: dict, config: dict, counts: dict) -> list[Path]:
+def export(review: Review, data_dir: Path, info: dict, config: dict, counts: dict, revision: str) -> list[Path]:
+    """Every table as Parquet and CSV, and the card; `revision` is the code revision that made the run."""
     out = dataset_dir(data_dir)
     out.mkdir(parents=True, exist_ok=True)
     written = []
@@ -76,5 +68,5 @@ def export(review: Review, data_dir: Path, info: dict, config: dict, counts: dic
             with files.atomic_path(out / f"{name}{suffix}") as tmp:
                 write(frame, tmp)
             written.append(out / f"{name}{suffix}")
-    written.append(files.write_text(out / "README.md", card(review, info, config, counts)))
+    written.append(files.write_text(out / "README.md", card(review, info, config, counts, revision)))
     return written

@@ -12,11 +12,11 @@ import numpy as np
 import pandas as pd
 
 from pipeline.core.runlog import Run
-from pipeline.papers.gripper_review.curated import CLASSES, COLUMNS
+from pipeline.papers.gripper_review.curated import CLASSES, COLUMNS, expand_refs
 
 slug = "gripper-review"
-# gripper-force-control's verified grasp-force range (its abstract: "3-48 N"): a force the review quotes for a
-# parallel-jaw design inside it is one that model can be set to
+# gripper-force-control's grasp-force range (its abstract: "3-48 N"): a force the review quotes for a
+# parallel-jaw design inside it is one that model can be set to (sections.py)
 GFC_FORCE_RANGE = (3.0, 48.0)
 SHORT = {"completely constrained": "cc", "underconstrained": "uc", "deformable": "def"}
 
@@ -53,8 +53,6 @@ def read_review(run: Run) -> Review:
 
 def expand(tables: dict[str, pd.DataFrame], name: str) -> pd.DataFrame:
     """A table with one row per reference of its `refs` cell (row-spans of the printed Table 1 carried down)."""
-    from pipeline.papers.gripper_review.curated import expand_refs
-
     frame = tables[name].copy()
     if name == "table1_printed":
         frame[["class", "design", "actuation"]] = frame[["class", "design", "actuation"]].replace("", np.nan).ffill()
@@ -107,7 +105,7 @@ def table3_checks(review: Review) -> dict[str, tuple[float, str]]:
     return out
 
 
-def table2_size_checks(review: Review) -> tuple[dict[str, tuple[float, str]], pd.DataFrame]:
+def table2_size_checks(review: Review) -> dict[str, tuple[float, str]]:
     """Table 2's size classes against the object sizes Sect. 2 quotes for the grippers it places in them: a
     placement is outside when the quoted sizes do not overlap the class's interval."""
     sizes = review.tables["table2_sizes"].set_index("size")[["min_m", "max_m"]].astype(float)
@@ -120,20 +118,5 @@ def table2_size_checks(review: Review) -> tuple[dict[str, tuple[float, str]], pd
     placed["class_min_m"] = placed["type2"].map(sizes["min_m"])
     placed["class_max_m"] = placed["type2"].map(sizes["max_m"])
     placed["outside"] = (high < placed["class_min_m"]) | (low > placed["class_max_m"])
-    return ({"table2.size_checked": (len(placed), "count"), "table2.size_outside": (int(placed["outside"].sum()),
-                                                                                   "count")},
-            placed[["ref", "type2", "object_size_min_m", "object_size_max_m", "class_min_m", "class_max_m",
-                    "outside"]])
-
-
-def stated(review: Review) -> dict[str, float]:
-    s = review.tables["stated"]
-    return {(q if not o else f"{q}.{SHORT.get(o, o)}"): float(c) for q, o, c in zip(s["quantity"], s["of"].fillna(""),
-                                                                                     s["count"], strict=True)}
-
-
-def gfc_candidates(grippers: pd.DataFrame) -> pd.DataFrame:
-    """Parallel-jaw designs whose quoted grasp force lies in gripper-force-control's verified range."""
-    low, high = GFC_FORCE_RANGE
-    force = grippers["grasp_force_n"]
-    return grippers[grippers["parallel_jaw"] & force.between(low, high)]
+    return {"table2.size_checked": (len(placed), "count"),
+            "table2.size_outside": (int(placed["outside"].sum()), "count")}

@@ -276,9 +276,9 @@ def curate(entries: list[dict], tables: dict, gravity: float) -> Curated:
                        table1_actuation=t1[ref]["actuation"], table1_reading=t1[ref]["reading"],
                        table1_printed_class=t1_printed[ref]["class"], table1_printed_design=t1_printed[ref]["design"])
             cells += [{"ref": ref, "column": c, "printed": row[c], "unit": "", "where": "Table 1", "quote": "",
-                       "qualifier": "", "reading": t1[ref]["reading"] if c.startswith("table1_") and "printed" not in c
-                       else "printed"} for c in ("table1_class", "table1_design", "table1_actuation",
-                                                 "table1_printed_class", "table1_printed_design")]
+                       "qualifier": "", "reading": "printed" if "printed" in c else t1[ref]["reading"]}
+                      for c in ("table1_class", "table1_design", "table1_actuation", "table1_printed_class",
+                                "table1_printed_design")]
         if ref in t2:
             row["table2"] = "; ".join(t2[ref])
             cells.append({"ref": ref, "column": "table2", "printed": row["table2"], "unit": "", "where": "Table 2",
