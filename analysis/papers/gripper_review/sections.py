@@ -12,7 +12,7 @@ from pipeline.papers.gripper_review.curated import ACTUATIONS, CLASSES
 
 def _counts(frame: pd.DataFrame) -> Section:
     values = frame.set_index("metric")["value"]
-    grid = pd.DataFrame(0, index=list(CLASSES), columns=list(ACTUATIONS))
+    grid = pd.DataFrame(0, index=pd.Index(CLASSES, name="class"), columns=list(ACTUATIONS))
     for cls in CLASSES:
         for actuation in ACTUATIONS:
             grid.loc[cls, actuation] = int(values.get(f"count.class_actuation.{SHORT[cls]}.{actuation}", 0))
