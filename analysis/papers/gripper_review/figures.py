@@ -34,6 +34,7 @@ def force_payload_figure(grippers: pd.DataFrame, gravity: float, figures: Figure
         ax.set_xticks(range(len(CLASSES)), [c.replace(" ", "\n") for c in CLASSES])
         ax.set_xlim(-0.6, len(CLASSES) - 0.4)
         ax.set_yscale("log")
+        ax.set_ylim(5e-3, 300)
         ax.set_title(f"{title} quoted in Sect. 2")
     # Table 3's load claims, as printed in kg, drawn as weights
     for target, cls, text in (("T3.cc.load", 0, "> 10 kg"), ("T3.uc.load", 1, "≤ 5 kg")):
