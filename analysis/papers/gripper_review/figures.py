@@ -18,7 +18,7 @@ BOUND_MARKERS = {"<=": "$\\downarrow$", "<": "$\\downarrow$", ">": "$\\uparrow$"
 
 def force_payload_figure(grippers: pd.DataFrame, gravity: float, figures: Figures) -> None:
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.6), sharey=True)
-    spread = np.linspace(-0.3, 0.3, len(ACTUATIONS))
+    spread = np.linspace(-0.42, 0.42, len(ACTUATIONS))
     for ax, column, title in ((axes[0], "grasp_force", "grasp force"), (axes[1], "payload", "payload (weight)")):
         quoted = grippers.dropna(subset=[f"{column}_n"]).sort_values(f"{column}_n")
         for actuation, rows in quoted.groupby("actuation"):
