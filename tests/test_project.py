@@ -20,6 +20,9 @@ def test_every_experiment_is_a_dvc_stage_and_has_code():
     dvc = yaml.safe_load((ROOT / "dvc.yaml").read_text())
     staged = {f"{v['slug']}/{v['name']}" for v in dvc["vars"][0]["experiments"].values()}
     assert staged == set(available_experiments())
+    analysed = {slug: v["module"] for slug, v in dvc["vars"][1]["papers"].items()}  # one analyze stage per paper
+    assert analysed == {slug: module_name(slug) for slug in analyzed_slugs()}
+    assert set(analysed) == {e.split("/")[0] for e in available_experiments()}
     for experiment in available_experiments():
         slug, name = experiment.split("/")
         assert name in paper_module(slug).EXPERIMENTS

@@ -185,7 +185,8 @@ def test_runs_in_parallel_processes_equal_runs_in_one(tmp_path):
 def test_a_timed_experiment_runs_its_cases_alone(tmp_path):
     """Its runs one after another, also as a sweep (whose local launcher would otherwise run one job per core)."""
     proc = run_cli("pipeline", "-m", "experiment=curve-discretization/timing-fig3", "scenario.joint_counts.last=6",
-                   "scenario.repeats=2", "scenario.warmup=1", "seed=0,1", f"data_dir={tmp_path}", f"sweep_dir={tmp_path}",
+                   "scenario.repeats=2", "scenario.warmup=1", "seed=0,1", f"data_dir={tmp_path}",
+                   f"sweep_dir={tmp_path}",
                    "progress=false")
     assert proc.returncode == 0, proc.stderr
     assert "n_jobs=1" in proc.stdout + proc.stderr
