@@ -26,7 +26,7 @@ def test_setpoint_and_a_maps_sweep_to_report(data_dir):
 
     runs = read_runs(data_dir / "runs" / SLUG / "maps")
     assert len(runs) == 2 and all(r.ok for r in runs)
-    assert {r.params["scenario.d_xyz"] for r in runs} == {"4000", "5000"}
+    assert {r.params["scenario.d_xyz"] for r in runs} == {4000, 5000}   # typed from the resolved config
     run = runs[0]
     assert {"/joint_state", "/reference", "/command", "/tracking_error", "/compute_time", "/tf"} <= set(run.topic_names)
     assert "model.yaml" in run.attachments and "config.yaml" in run.attachments

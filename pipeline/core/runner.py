@@ -10,14 +10,14 @@ import time
 import traceback
 from pathlib import Path
 
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig, ListConfig, OmegaConf
 from tqdm import tqdm
 
 from pipeline.core import interrupts, provenance
 from pipeline.core.checks import BadInput, check_cases
 from pipeline.core.experiment import resolve
 from pipeline.core.files import Busy, Locks, stale_partials
-from pipeline.core.runlog import CONFIG_ATTACHMENT, RunWriter, SimulationFailed
+from pipeline.core.runlog import CONFIG_ATTACHMENT, RunWriter, SimulationFailed, typed
 
 # Overrides that do not change what is simulated, so they do not name a run.
 NOT_PARAMS = ("experiment", "data_dir", "progress")
@@ -32,6 +32,16 @@ def run_params(overrides: list[str]) -> dict[str, str]:
         if key not in NOT_PARAMS and not key.startswith("hydra"):
             params[key] = value
     return params
+
+
+def run_values(cfg: DictConfig, params: dict[str, str]) -> dict:
+    """The overrides' values as the resolved config holds them: typed (numbers as numbers, lists as lists)."""
+    values = {}
+    for key in params:
+        value = OmegaConf.select(cfg, key, default=None, throw_on_missing=False)
+        value = OmegaConf.to_container(value, resolve=True) if isinstance(value, DictConfig | ListConfig) else value
+        values[key] = typed(params[key]) if value is None else value
+    return values
 
 
 def run_id(case: str, params: dict[str, str]) -> str:
@@ -81,7 +91,7 @@ def simulate(cfg: DictConfig, experiment_id: str, overrides: list[str] | None = 
             bar.set_postfix_str(rid)
             status, bug = _run_case(case, rid, out_dir, config_yaml, {
                 "slug": slug, "experiment": name, "run_id": rid, "case": case.id, "seed": str(cfg.seed),
-                "params": params, "git_revision": provenance.git_revision(),
+                "params": params, "values": run_values(cfg, params), "git_revision": provenance.git_revision(),
                 "package_versions": provenance.package_versions(), "machine": provenance.machine(),
                 "created": dt.datetime.now(dt.UTC).isoformat(timespec="seconds"),
             })

@@ -16,6 +16,8 @@ from pipeline.papers.scara_half_derivative.closed_loop import ClosedLoopRun, Pla
 from pipeline.papers.scara_half_derivative.controller import CartesianController, Gains
 from pipeline.papers.scara_half_derivative.setpoint import Motion
 
+EXTERNAL_UNITS = ["m", "m", "m", "rad"]   # x, y, z of E and its heading theta
+
 
 def arm_of(cfg: DictConfig) -> Arm:
     return Arm.from_config(cfg.system)
@@ -72,14 +74,15 @@ def log_closed_loop(log: RunWriter, cfg: DictConfig, arm: Arm, motion: Motion, r
     period = cfg.system.control.dt
     held = run.tau[np.minimum((t / period + 1e-9).astype(int), len(run.tau) - 1)]
     error = x_d - fk(arm, q)
-    log.log_series("/reference", t, name=list(EXTERNAL), position=x_d, velocity=xd_d, acceleration=xdd_d)
-    log.log_series("/joint_state", t, name=list(JOINTS), position=q, velocity=qd, effort=held)
-    log.log_series("/tracking_error", t, name=list(EXTERNAL), error=error,
-                   norm=np.linalg.norm(error[:, :3], axis=1))
-    log.log_series("/command", run.t_control, kind="torque", name=list(JOINTS), value=run.tau)
+    log.log_series("/reference", t, units=EXTERNAL_UNITS, name=list(EXTERNAL), position=x_d, velocity=xd_d,
+                   acceleration=xdd_d)
+    log.log_series("/joint_state", t, units="rad", name=list(JOINTS), position=q, velocity=qd, effort=held)
+    log.log_series("/tracking_error", t, units=EXTERNAL_UNITS, field_units={"norm": "m"}, name=list(EXTERNAL),
+                   error=error, norm=np.linalg.norm(error[:, :3], axis=1))
+    log.log_series("/command", run.t_control, units="rad", kind="torque", name=list(JOINTS), value=run.tau)
     log.log_series("/compute_time", run.t_control, name=[law], seconds=run.controller_s[:, None], calls=[1])
     if run.loop_residual is not None:
-        log.log_series("/loop_closure", run.t_control, schemas.Scalars, name=["gap"],
+        log.log_series("/loop_closure", run.t_control, schemas.Scalars, name=["gap"], units="m",
                        value=run.loop_residual[:, None])
     tf = slice(None, None, _stride(ex.tf_dt, dt, "execute.tf_dt"))
     log.log_transforms(run.t[tf], "base", [*LINKS, "E", "setpoint"],
@@ -115,9 +118,11 @@ def setpoint(cfg: DictConfig) -> list[Case]:
         x_d, xd_d, xdd_d = motion(t)
         q_d = ik(arm, x_d)
         qd_d = np.linalg.solve(jacobian(arm, q_d), xd_d[..., None])[..., 0]
-        log.log_series("/reference", t, name=list(EXTERNAL), position=x_d, velocity=xd_d, acceleration=xdd_d)
-        log.log_series("/reference/joints", t, schemas.Reference, name=list(JOINTS), position=q_d, velocity=qd_d)
-        log.log_series("/setpoint/check", t, schemas.Scalars, name=["fk_ik_error"],
+        log.log_series("/reference", t, units=EXTERNAL_UNITS, name=list(EXTERNAL), position=x_d, velocity=xd_d,
+                       acceleration=xdd_d)
+        log.log_series("/reference/joints", t, schemas.Reference, units="rad", name=list(JOINTS), position=q_d,
+                       velocity=qd_d)
+        log.log_series("/setpoint/check", t, schemas.Scalars, name=["fk_ik_error"], units="m & rad",
                        value=np.abs(fk(arm, q_d) - x_d).max(axis=1)[:, None])
         tf = slice(None, None, max(1, round(cfg.scenario.tf_dt / cfg.scenario.dt)))
         log.log_transforms(t[tf], "base", [*LINKS, "E", "setpoint"], _frames_with_end_effector(arm, q_d[tf], x_d[tf]))
