@@ -346,6 +346,9 @@ class Run:
         channels = summary.channels.values() if summary else []
         self.topic_names = sorted({c.topic for c in channels})
         self._units = {c.topic: json.loads(c.metadata.get(UNITS_KEY, "{}")) for c in channels}
+        self._schemas = {c.topic: summary.schemas[c.schema_id].name for c in channels}
+        counts = summary.statistics.channel_message_counts if summary and summary.statistics else {}
+        self._counts = {c.topic: counts.get(i, 0) for i, c in (summary.channels.items() if summary else [])}
         self._frames: dict[str, pd.DataFrame] = {}
 
     def __repr__(self) -> str:
@@ -387,6 +390,13 @@ class Run:
         if values is not None:
             return json.loads(values)
         return {k: typed(v) for k, v in json.loads(self.metadata.get("params", "{}")).items()}
+
+    def schema_name(self, topic: str) -> str:
+        """The full name of a topic's schema (`repro.JointState`, `foxglove.FrameTransforms`, ...)."""
+        return self._schemas[topic]
+
+    def message_count(self, topic: str) -> int:
+        return self._counts.get(topic, 0)
 
     def units(self, topic: str) -> dict[str, str]:
         """Column -> unit of a topic (what the writer declared; Foxglove schemas: metres, unit quaternions)."""
