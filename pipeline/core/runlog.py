@@ -235,8 +235,8 @@ class RunWriter:
         self._queue(topic, cls)  # the topic's schema first: a reserved topic refuses another
         key = (topic, cls, tuple(names or ()), sample.get("kind", ""),
                units if units is None or isinstance(units, str) else tuple(units),
-               tuple(sorted((k, v if isinstance(v, str) else tuple(v)) for k, v in (field_units or {}).items())),
-               tuple((k, np.size(v)) for k, v in sample.items() if k != "name"))
+               tuple((k, v if isinstance(v, str) else tuple(v)) for k, v in (field_units or {}).items()),
+               tuple((k, len(v) if isinstance(v, list | tuple | np.ndarray) else -1) for k, v in sample.items()))
         if key in self._declared:
             return
         self._declared.add(key)

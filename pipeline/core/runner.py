@@ -10,17 +10,18 @@ import time
 import traceback
 from pathlib import Path
 
+import yaml
 from omegaconf import DictConfig, ListConfig, OmegaConf
 from tqdm import tqdm
 
-from pipeline.core import interrupts, provenance
+from pipeline.core import episodes, interrupts, parallel, provenance
 from pipeline.core.checks import BadInput, check_cases
 from pipeline.core.experiment import resolve
 from pipeline.core.files import Busy, Locks, stale_partials
 from pipeline.core.runlog import CONFIG_ATTACHMENT, RunWriter, SimulationFailed, typed
 
 # Overrides that do not change what is simulated, so they do not name a run.
-NOT_PARAMS = ("experiment", "data_dir", "progress")
+NOT_PARAMS = ("experiment", "data_dir", "progress", "episodes.count", "episodes.workers")
 MAX_ID = 120
 
 
@@ -72,7 +73,8 @@ def simulate(cfg: DictConfig, experiment_id: str, overrides: list[str] | None = 
     out_dir = data_dir / "runs" / slug / name
     config_yaml = OmegaConf.to_yaml(cfg, resolve=True)
     cases = check_cases(cfg, experiment)
-    ids = [run_id(case.id, params) for case in cases]
+    names = [f"episode-{i:06d}" for i in range(cfg.episodes.count)] or [case.id for case in cases]
+    ids = [run_id(name, params) for name in names]
     interrupts.install()
     locks = Locks(data_dir, [f"{slug}/{name}/{rid}" for rid in ids])
     try:
@@ -85,22 +87,43 @@ def simulate(cfg: DictConfig, experiment_id: str, overrides: list[str] | None = 
         for rid in ids:  # left by writers that died: nobody else can hold these names now
             for stale in stale_partials(out_dir / f"{rid}.mcap"):
                 stale.unlink(missing_ok=True)
-        bar = tqdm(list(zip(cases, ids, strict=True)), desc=experiment_id, unit="run",
-                   disable=None if cfg.progress else True, leave=False, file=sys.stderr)
-        for case, rid in bar:
-            bar.set_postfix_str(rid)
-            status, bug = _run_case(case, rid, out_dir, config_yaml, {
-                "slug": slug, "experiment": name, "run_id": rid, "case": case.id, "seed": str(cfg.seed),
-                "params": params, "values": run_values(cfg, params), "git_revision": provenance.git_revision(),
-                "package_versions": provenance.package_versions(), "machine": provenance.machine(),
-                "created": dt.datetime.now(dt.UTC).isoformat(timespec="seconds"),
-            })
+        bar = tqdm(total=len(ids), desc=experiment_id, unit="run", disable=None if cfg.progress else True,
+                   leave=False, file=sys.stderr)
+        for rid, status, bug in _runs(cfg, experiment, cases, ids, out_dir, config_yaml, {
+                "slug": slug, "experiment": name, "params": params, "values": run_values(cfg, params),
+                "git_revision": provenance.git_revision(), "package_versions": provenance.package_versions(),
+                "machine": provenance.machine(), "created": dt.datetime.now(dt.UTC).isoformat(timespec="seconds")}):
+            bar.update()
             errors += bug
             tqdm.write(f"{experiment_id} {rid}: {status}" if status != "ok" else f"wrote {out_dir / rid}.mcap",
                        file=sys.stderr)
+        bar.close()
     finally:
         locks.release()
     return errors
+
+
+def _runs(cfg: DictConfig, experiment, cases, ids: list[str], out_dir: Path, config_yaml: str, metadata: dict):
+    """(run id, status, bug) of every run: the experiment's cases here, or its episodes over the cores."""
+    if not cfg.episodes.count:
+        for case, rid in zip(cases, ids, strict=True):
+            status, bug = _run_case(case, rid, out_dir, config_yaml, {
+                **metadata, "run_id": rid, "case": case.id, "seed": str(cfg.seed)})
+            yield rid, status, bug
+        return
+    described = {key: episodes.describe(dist) for key, dist in episodes.randomized(cfg).items()}
+    base = OmegaConf.to_container(cfg, resolve=True)
+
+    def episode(index: int) -> tuple[str, str, bool]:
+        values = episodes.draw(cfg, index)
+        plain = episodes.apply(base, values, episodes.seed_of(cfg, index))
+        case = experiment.fn(OmegaConf.create(plain))[0]
+        status, bug = _run_case(case, ids[index], out_dir, yaml.safe_dump(plain, sort_keys=False), {
+            **metadata, "run_id": ids[index], "case": case.id, "seed": str(plain["seed"]), "episode": str(index),
+            "episodes_seed": str(cfg.seed), "randomized": described, "values": {**metadata["values"], **values}})
+        return ids[index], status, bug
+
+    yield from parallel.imap(episode, range(cfg.episodes.count), cfg.episodes.workers)
 
 
 def _run_case(case, rid: str, out_dir: Path, config_yaml: str, metadata: dict) -> tuple[str, bool]:
