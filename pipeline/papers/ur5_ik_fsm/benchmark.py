@@ -1,5 +1,6 @@
-"""Speed of `ur5-ik-fsm`: the MuJoCo execution against bare stepping, and IK per call (with the
-compiled `ur-analytic-ik` as a peer when the [bench] extra is installed)."""
+"""Speed of `ur5-ik-fsm`: the MuJoCo execution against bare stepping, IK per call (with the compiled
+`ur-analytic-ik` as a peer when the [bench] extra is installed), and the dataset generator (1,000 randomized
+episodes simulated, logged and exported; goal ≤ 2 minutes on 2 cores)."""
 
 from __future__ import annotations
 
@@ -107,4 +108,76 @@ def benchmark() -> list[dict]:
     rows: list[dict] = []
     execution(rows)
     ik_per_call(rows)
+    dataset(rows)
     return rows
+
+
+def dataset(rows: list[dict], episodes: int = 1000) -> None:
+    """The dataset generator end to end, as a user runs it: `episodes` randomized paths (random-paths) simulated
+    and logged in one process over the cores, then exported as a LeRobot dataset; and where one episode's time
+    goes, measured in this process on a few episodes."""
+    import subprocess
+    import sys
+    import time
+
+    import yaml
+    from omegaconf import OmegaConf
+
+    from pipeline.core import episodes as ep
+    from pipeline.core import parallel
+    from pipeline.core.experiment import resolve
+    from pipeline.core.runner import _run_case
+
+    what = f"dataset generator: {episodes} random-paths episodes"
+    with tempfile.TemporaryDirectory() as tmp:
+        start = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "pipeline", "experiment=ur5-ik-fsm/random-paths",
+                        f"episodes.count={episodes}", f"data_dir={tmp}", "progress=false"], check=True,
+                       capture_output=True)
+        simulated = time.perf_counter() - start
+        subprocess.run([sys.executable, "-m", "pipeline.dataset", "ur5-ik-fsm/random-paths", "--data-dir", tmp],
+                       check=True, capture_output=True)
+        total = time.perf_counter() - start
+        size = sum(p.stat().st_size for p in (Path(tmp) / "datasets").rglob("*") if p.is_file())
+    workers = parallel.workers_for(0, episodes)
+    rows += [
+        {"what": what, "measure": f"simulate + log ({workers} workers, one process start)", "value": simulated,
+         "unit": "s"},
+        {"what": what, "measure": "export to LeRobot v3.0 (one process)", "value": total - simulated, "unit": "s"},
+        {"what": what, "measure": "simulated, logged and exported", "value": total, "unit": "s", "goal": "≤ 120"},
+        {"what": what, "measure": "episodes per second", "value": episodes / total, "unit": "1/s"},
+        {"what": what, "measure": "dataset size", "value": size / 1e6, "unit": "MB"},
+    ]
+    # one episode's parts (one core): drawing the config, the IK along the path, MuJoCo, logging + writing
+    cfg = compose_config(["experiment=ur5-ik-fsm/random-paths"])
+    experiment = resolve("ur5-ik-fsm/random-paths")
+    base = OmegaConf.to_container(cfg, resolve=True)
+    parts: dict[str, list[float]] = {"config": [], "IK along the path (2001 scalar calls)": [],
+                                     "MuJoCo servo (rollout)": [], "logging + MCAP write": [], "episode": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        for index in range(12):
+            t0 = time.perf_counter()
+            plain = ep.apply(base, ep.draw(cfg, index), ep.seed_of(cfg, index))
+            episode_cfg = OmegaConf.create(plain)
+            case = experiment.fn(episode_cfg)[0]
+            config_yaml = yaml.safe_dump(plain, sort_keys=False)
+            t1 = time.perf_counter()
+            path, crossing, algorithm = case.id.split("-")
+            ik_times, _, q_ik, _ = ex.solve_path(episode_cfg, path, crossing, algorithm)
+            t2 = time.perf_counter()
+            times, q_ref, qd_ref = ex.servo_references(q_ik, ik_times, episode_cfg.execute.dt, True,
+                                                       episode_cfg.system.dynamics.velocity_limit)
+            ex.run_servo(ex.arm_model(episode_cfg, ex.geometry(episode_cfg), q_ref[0]), q_ref, qd_ref, times)
+            t3 = time.perf_counter()
+            _run_case(case, f"e{index}", Path(tmp), config_yaml, {"run_id": f"e{index}"})
+            t4 = time.perf_counter()
+            if index:  # the first one warms caches
+                full = t4 - t3
+                parts["config"].append(t1 - t0)
+                parts["IK along the path (2001 scalar calls)"].append(t2 - t1)
+                parts["MuJoCo servo (rollout)"].append(t3 - t2)
+                parts["logging + MCAP write"].append(full - (t3 - t1))
+                parts["episode"].append(full + t1 - t0)
+    for part, values in parts.items():
+        rows.append({"what": "one random-paths episode (median of 11)", "measure": part,
+                     "value": float(np.median(values)) * 1e3, "unit": "ms"})
