@@ -7,7 +7,14 @@ A paper opts in with `pipeline/papers/<module>/benchmark.py` exposing `benchmark
 what, measure, value, unit, and optionally p95, goal, paper). Timing lives here, never in the tests.
 """
 
+# ruff: noqa: E402  (the BLAS thread count must be set before NumPy is imported)
 from __future__ import annotations
+
+import os
+
+# One BLAS thread, as in the pipeline (pipeline/__main__.py): the timings are single-threaded.
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
 
 import importlib
 import math

@@ -25,8 +25,9 @@ def test_pipeline_to_report(data_dir):
         assert (report / name).is_file(), name
     targets = pd.read_csv(report / "targets.csv")
     assert list(targets.columns) == ["slug", "target_id", "category", "quantity", "where", "paper_value", "op",
-                                     "pipeline_value", "deviation", "relative_deviation", "unit", "mode", "basis",
-                                     "tolerance", "status", "cause", "note", "experiment", "run"]
+                                     "pipeline_value", "band_min", "band_max", "deviation", "relative_deviation",
+                                     "unit", "mode", "basis", "tolerance", "status", "cause", "note", "experiment",
+                                     "run"]
     assert set(targets["status"]) <= {"match", "close", "consistent", "miss", "not run", "not-reproducible",
                                       "agrees", "disagrees"}
     targets = targets[targets["slug"] == "ur5-ik-fsm"]   # other papers' targets have no runs here

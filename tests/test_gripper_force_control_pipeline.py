@@ -1,9 +1,11 @@
 """gripper-force-control end to end, as a user runs it: every experiment (the surface as a Hydra sweep of two
-points, the Monte-Carlo shortened), the analysis, and the statuses the report must reach."""
+points, the friction band at the ends of its range, the Monte-Carlo shortened), the analysis, and the statuses
+the report must reach."""
 
 from __future__ import annotations
 
 import pandas as pd
+import pytest
 
 from pipeline.core.runlog import read_run, run_files
 
@@ -16,6 +18,7 @@ def test_experiments_to_report(data_dir):
     runs = (
         ["experiment=gripper-force-control/tables"],
         ["experiment=gripper-force-control/force-sag"],
+        ["-m", "experiment=gripper-force-control/force-sag-friction", "system.friction.m1_coulomb=0.01,0.045"],
         ["-m", "experiment=gripper-force-control/force-error-surface", "scenario.omega=0.9,5.6"],
         ["experiment=gripper-force-control/pick-and-place"],
         ["experiment=gripper-force-control/steady-state", "scenario.grasps=3", "scenario.duration=0.15"],
@@ -40,6 +43,16 @@ def test_experiments_to_report(data_dir):
     assert status["tomato.rotate"] != "match"                  # 45° cannot take 130 ms at the stated limits
     live = targets[targets["mode"] != "not reproducible"]
     assert live["pipeline_value"].notna().all(), live[live["pipeline_value"].isna()].index.tolist()
+    # the friction band: more friction, more sag, in both cases; the default run lies inside its band
+    band = pd.read_parquet(data_dir / f"metrics/{SLUG}/force-sag-friction.parquet")
+    sag = band[band["metric"] == "force_error.sag"].set_index("run_id")["value"]
+    for case in ("friction-mujoco", "no-feedforward-mujoco"):
+        low, high = (sag[f"{case}__system.friction.m1_coulomb={c}"] for c in ("0.01", "0.045"))
+        assert high > 2 * low
+        row = targets[targets["run"] == case].iloc[0]
+        assert (row["band_min"], row["band_max"]) == pytest.approx((100 * low, 100 * high))
+        assert row["band_min"] < row["pipeline_value"] < row["band_max"]
+    assert status["F8.no-ff"] in ("match", "consistent")       # never merged: a band makes it consistent
     surface = pd.read_parquet(data_dir / f"metrics/{SLUG}/force-error-surface.parquet")
     assert surface.loc[surface["metric"] == "points", "value"].item() == 2    # both sweep points assembled
     for figure in ("force-sag/fig8-force-sag", "force-error-surface/fig9-force-error-surface",

@@ -8,6 +8,7 @@ import pandas as pd
 import pytest
 
 from pipeline.core.checks import compose_config
+from pipeline.core.runlog import read_run, run_files
 from pipeline.papers.nmpc_cdkd import experiments as ex
 from pipeline.papers.nmpc_cdkd import kinematics as kin
 from pipeline.papers.nmpc_cdkd.plant import KinematicPlant
@@ -103,3 +104,12 @@ def test_pipeline_runs_fig3_and_reports(data_dir):
 def test_bad_horizon_is_refused():
     proc = run_cli("pipeline", "experiment=nmpc-cdkd/tracking", "system.nmpc.horizon_steps=1")
     assert proc.returncode == 2 and "horizon_steps" in proc.stderr
+
+
+def test_compute_time_runs_on_the_kinematic_plant(data_dir):
+    proc = run_cli("pipeline", "experiment=nmpc-cdkd/compute-time", "scenario.cases=[no-obstacle]",
+                   "scenario.horizons=[10]", f"data_dir={data_dir}", "progress=false")
+    assert proc.returncode == 0, proc.stderr
+    runs = [read_run(p) for p in run_files(data_dir / "runs/nmpc-cdkd/compute-time")]
+    assert len(runs) == 2 and all(r.ok for r in runs), [r.status for r in runs]
+    assert "effort" not in " ".join(runs[0]["/joint_state"].columns)  # a kinematic plant has no torques

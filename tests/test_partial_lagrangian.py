@@ -255,13 +255,38 @@ def test_term_counts_and_slope():
     assert slope(n, 2e-6 * n ** 3.0) == pytest.approx(3.0)
 
 
+@pytest.mark.parametrize("n", [1, 2, 3, 4])
+def test_symbolic_counts_are_the_terms_of_the_expanded_equations(n):
+    """The ring count of each link equals expanding the usual L and its τ_k with sympy.expand: no term of one
+    link merges with another's, so τ_k has the terms of Table 1's row k summed."""
+    from pipeline.papers.partial_lagrangian.symbolic import expanded_counts, link_counts
+
+    links = [link_counts(i) for i in range(n)]
+    lagrangian, taus = expanded_counts(n)
+    assert lagrangian == sum(link.lagrangian for link in links)
+    assert taus == [sum(link.tau[k] for link in links[k:]) for k in range(n)]
+
+
+def test_symbolic_counts_of_one_link_and_their_structure():
+    """One link: L = ½ m l² θ̇² − ½ k l² − m g l sin θ (3 terms), τ = m l² θ̈ + m g l cos θ (2). Every link has
+    as many derivatives as coordinates, and the counts of a link do not depend on the links after it."""
+    from pipeline.papers.partial_lagrangian.symbolic import link_counts
+
+    one = link_counts(0)
+    assert (one.lagrangian, one.d_angle, one.d_rate, one.tau) == (3, [1], [1], [2])
+    third = link_counts(2)
+    assert len(third.tau) == len(third.d_angle) == len(third.d_rate) == 3
+    assert all(t > 0 for t in third.tau) and third.tau[0] == max(third.tau)
+
+
 # -- end to end ------------------------------------------------------------------------------------------------------
 
 
 def test_slider_and_compute_time_end_to_end(data_dir):
     for args in (["experiment=partial-lagrangian/slider"],
                  ["experiment=partial-lagrangian/compute-time", "scenario.links=[1,2,3,4]", "scenario.states=10",
-                  "scenario.eval_repeats=3", "scenario.build_repeats=1"]):
+                  "scenario.eval_repeats=3", "scenario.build_repeats=1"],
+                 ["experiment=partial-lagrangian/term-counts", "scenario.links=[1,2,3,4]"]):
         proc = run_cli("pipeline", *args, f"data_dir={data_dir}", "progress=false")
         assert proc.returncode == 0, proc.stderr
     proc = run_cli("analysis", f"data_dir={data_dir}")
@@ -270,6 +295,11 @@ def test_slider_and_compute_time_end_to_end(data_dir):
     assert targets.loc["F4.l2", "status"] == "match"
     page = (data_dir / "report/partial-lagrangian.md").read_text()
     assert "Compute time by number of links" in page and "Measured on" in page
+    assert "Terms of the symbolic equations of motion" in page
+    # a chain of n links is links 1..n: all its τ_ki are the columns summed
+    counts = pd.read_parquet(data_dir / "metrics/partial-lagrangian/term-counts.parquet").set_index("metric")["value"]
+    assert counts["sym.all_tau.n4"] == sum(counts[f"sym.column.n{n}"] for n in (1, 2, 3, 4))
+    assert counts["eq28.n4"] == 240 and counts["sym.ratio.n4"] == counts["sym.all_tau.n4"] / counts["sym.column.n4"]
     assert list((data_dir / "figures/partial-lagrangian/slider").glob("*.png"))
 
 

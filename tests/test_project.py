@@ -99,3 +99,22 @@ def test_a_target_of_a_failed_run_says_why():
     assert row["status"] == "miss" and "failed: diverged at t = 1 s" in row["note"] and row["cause"] == "open"
     never_ran = evaluate("s", targets, {}, runs.assign(experiment="other")).iloc[0]
     assert never_ran["status"] == "not run"
+
+
+def test_mujoco_geoms_are_drawn_in_their_bodys_frame():
+    import mujoco
+
+    from pipeline.core import markers
+
+    model = mujoco.MjModel.from_xml_string("""<mujoco><worldbody><geom type="plane" size="1 1 0.1"/>
+      <body name="b" pos="0 0 1"><freejoint/><geom type="box" size="0.1 0.2 0.3" pos="0 0 0.5"/>
+      <geom type="capsule" size="0.05 0.2"/><geom type="sphere" size="0.07" rgba="1 0 0 1"/></body>
+      </worldbody></mujoco>""")
+    world, body = markers.mujoco_geoms(model)
+    assert world.frame_id == "world" and world.cubes[0].size.z == pytest.approx(0.002)
+    assert body.frame_id == "b" and body.frame_locked
+    cube = body.cubes[0]
+    assert [cube.size.x, cube.size.y, cube.size.z] == pytest.approx([0.2, 0.4, 0.6]) and cube.pose.position.z == 0.5
+    assert body.cylinders[0].size.z == pytest.approx(0.4) and len(body.spheres) == 3   # capsule ends + sphere
+    assert sorted(s.pose.position.z for s in body.spheres) == pytest.approx([-0.2, 0.0, 0.2])
+    assert body.spheres[-1].color.r == 1.0 and body.spheres[-1].size.x == pytest.approx(0.14)

@@ -14,15 +14,18 @@ from analysis.core import report
 from analysis.core.sections import Section, Table
 from analysis.core.stages import PAPERS_DIR, analyzed_slugs
 from analysis.core.targets import (
+    BAND_CAUSES,
     CATEGORIES,
     CLOSE_FACTOR,
     STATUS_MEANING,
     STATUSES,
     Tolerance,
+    band_runs,
     evaluate,
     judge,
     load_targets,
     paper_value,
+    self_check,
 )
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -94,7 +97,7 @@ def test_status_rules(pipeline, paper, op, tol, status):
 def _targets(**overrides) -> pd.DataFrame:
     row = {"target_id": "x", "category": "tracking errors", "quantity": "q", "where": "Table 1", "value": "1.0",
            "unit": "m", "mode": "exact", "op": "==", "tolerance": "0.1", "basis": "simulation", "cause": "",
-           "experiment": "exp", "run": "r1", "metric": "m", "note": ""}
+           "experiment": "exp", "run": "r1", "metric": "m", "band": "", "note": ""}
     return pd.DataFrame([row | overrides])
 
 
@@ -136,6 +139,97 @@ def test_consistency_rows_are_never_reproductions():
     assert off["status"] == "disagrees" and off["cause"] == "paper-inconsistent"
 
 
+# -- sensitivity bands ----------------------------------------------------------------------------------------------
+
+
+def test_band_reads_the_target_run_and_its_sweep_runs():
+    ids = pd.Series(["r1", "r1__k=2", "r1__a=0.5,b=2", "r1x", "r1-k=2", "r10__k=1", "r2__r1=1", "r1_"])
+    assert band_runs(ids, "r1").tolist() == [True, True, True, False, False, False, False, False]
+
+
+def _banded(default: float, swept: dict[str, float], cause: str = "parameter-missing", op: str = "==",
+            status: dict[str, str] | None = None):
+    """A target 1.0 ± 0.1 whose default run gives `default` and whose band experiment `sweep` gives `swept`."""
+    sweep = pd.DataFrame([{"run_id": r, "metric": "m", "value": v, "unit": "m"} for r, v in swept.items()])
+    runs = pd.concat([_runs(("r1", "ok")), pd.DataFrame([{"experiment": "sweep", "run_id": r,
+                                                         "status": (status or {}).get(r, "ok")} for r in swept])])
+    return evaluate("p", _targets(band="sweep", cause=cause, op=op), _metrics(default) | {"sweep": sweep},
+                    runs).iloc[0]
+
+
+def test_a_miss_whose_band_reaches_the_paper_is_consistent():
+    row = _banded(1.5, {"r1__k=1": 0.8, "r1__k=2": 1.2})
+    assert row["status"] == "consistent" and row["cause"] == "parameter-missing"
+    assert (row["pipeline_value"], row["band_min"], row["band_max"]) == (1.5, 0.8, 1.2)  # the default stays
+    assert _banded(1.15, {"r1__k=1": 0.95, "r1__k=2": 1.2})["status"] == "consistent"     # a close too
+    # a match stays a match, with its band shown
+    matched = _banded(1.05, {"r1__k=1": 0.5, "r1__k=2": 3.0})
+    assert matched["status"] == "match" and matched["band_max"] == 3.0
+    # an inequality is reached where it holds at the band's favourable end
+    assert _banded(1.5, {"r1__k=1": 0.7, "r1__k=2": 1.6}, op="<")["status"] == "consistent"
+    assert _banded(1.5, {"r1__k=1": 1.3, "r1__k=2": 1.6}, op="<", cause="model-limitation")["status"] == "miss"
+
+
+def test_a_band_counts_only_ok_runs_of_its_own_case():
+    # the run reaching the paper failed, and another case's sweep reaches it: neither counts
+    row = _banded(1.5, {"r1__k=1": 1.4, "r1__k=2": 1.0, "r10__k=1": 1.0}, cause="model-limitation",
+                  status={"r1__k=2": "failed: diverged"})
+    assert row["status"] == "miss" and (row["band_min"], row["band_max"]) == (1.4, 1.4)
+    assert row["cause"] == "model-limitation"
+    # the sweep is not on disk: no band, judged as without one
+    alone = evaluate("p", _targets(band="sweep", cause="parameter-missing"), _metrics(1.5), _runs(("r1", "ok")))
+    assert alone.iloc[0]["status"] == "miss" and math.isnan(alone.iloc[0]["band_min"])
+    assert not self_check(alone)
+
+
+def test_self_check_refuses_a_missing_parameter_its_band_cannot_explain():
+    bad = _banded(1.5, {"r1__k=1": 1.4, "r1__k=2": 1.6})                  # parameter-missing, band misses
+    assert bad["status"] == "miss"
+    problems = self_check(pd.DataFrame([bad]))
+    assert len(problems) == 1 and "p:x" in problems[0] and "parameter-missing" in problems[0]
+    assert all(cause in problems[0] for cause in BAND_CAUSES)
+    assert self_check(pd.DataFrame([_banded(1.5, {"r1__k=1": 1.4}, cause="")]))             # `open` neither
+    for cause in BAND_CAUSES:
+        assert not self_check(pd.DataFrame([_banded(1.5, {"r1__k=1": 1.4, "r1__k=2": 1.6}, cause=cause)]))
+    assert not self_check(pd.DataFrame([_banded(1.5, {"r1__k=1": 0.8, "r1__k=2": 1.2})]))   # consistent
+
+
+def test_the_report_stage_fails_its_self_check(tmp_path, monkeypatch, capsys):
+    """A banded target declared `parameter-missing` whose band cannot reach the paper: the report is still
+    written, every problem is named, and the stage exits 1 (so `dvc repro` stops)."""
+    from analysis.core import stages
+    from analysis.core.metrics import write_metrics
+
+    load = stages.load_targets
+
+    def with_band(path):
+        targets = load(path)
+        targets.loc[0, ["band", "cause"]] = ["tables-sweep", "parameter-missing"]
+        return targets
+
+    monkeypatch.setattr(stages, "analyzed_slugs", lambda: ["ur5-ik-fsm"])
+    monkeypatch.setattr(stages, "load_targets", with_band)
+    first = with_band(PAPERS_DIR / "ur5_ik_fsm" / "targets.csv").iloc[0]
+    metrics = tmp_path / "metrics" / "ur5-ik-fsm"
+    metrics.mkdir(parents=True)
+    for name, ids in (("tables", [first["run"]]), ("tables-sweep", [f"{first['run']}__k=1", f"{first['run']}__k=2"])):
+        write_metrics(pd.DataFrame([{"run_id": r, "metric": first["metric"], "value": float(first["value"]) + 1 + k,
+                                     "unit": first["unit"]} for k, r in enumerate(ids)]), metrics / f"{name}.parquet")
+        pd.DataFrame({"run_id": ids, "status": "ok", "ok": True}).to_csv(metrics / f"{name}.runs.csv", index=False)
+    assert stages.run(tmp_path, None, "report") == 1
+    err = capsys.readouterr().err
+    assert f"ur5-ik-fsm:{first['target_id']}: miss with cause `parameter-missing`" in err
+    assert "band tables-sweep is named in targets.csv but not declared in paper.yaml" in err
+    assert (tmp_path / "report" / "ur5-ik-fsm.html").is_file()
+
+
+def test_a_band_belongs_to_a_reproduction_target(tmp_path):
+    path = tmp_path / "targets.csv"
+    _targets(mode="consistency", basis="paper", band="sweep").to_csv(path, index=False)
+    with pytest.raises(ValueError, match="a band belongs to a reproduction target"):
+        load_targets(path)
+
+
 def test_a_paper_basis_goes_only_with_consistency(tmp_path):
     path = tmp_path / "targets.csv"
     _targets(basis="paper").to_csv(path, index=False)
@@ -161,6 +255,13 @@ def test_paper_declarations(slug):
     text = (package / "paper.yaml").read_text() + "".join(targets["note"]) + "".join(
         p.read_text() for p in package.glob("*.py"))
     assert "spec §" not in text
+    # every band is justified in paper.yaml and is a disclosed sweep (`-m`) in dvc.yaml
+    bands = {b["experiment"]: b for b in info.get("bands") or []}
+    assert set(targets["band"]) - {""} <= set(bands), f"{slug}: bands not declared in paper.yaml"
+    sweeps = report._dvc_args()
+    for name, b in bands.items():
+        assert all(str(b.get(k, "")).strip() for k in ("parameter", "range", "why")), f"{slug}: band {name}"
+        assert sweeps.get(f"{slug}/{name}", "").startswith("-m "), f"{slug}: band {name} is not a -m sweep"
 
 
 def test_paper_values_are_read_from_targets():
@@ -185,6 +286,16 @@ def test_cells_with_pipes_and_markup_cannot_break_a_page(tmp_path):
     assert 'href="https://doi.org/10.1/x"' in html and "close" in html
     assert_tables_whole(html, "paper.html")
     markdown_rows_whole(report.render("paper.md.j2", **context), "paper.md")
+    # a band beside the default value, and the bands listed with their justification
+    banded = pd.concat([evaluated, pd.DataFrame([_banded(1.5, {"r1__k=1": 0.8, "r1__k=2": 1.2})])
+                        .assign(target_id="y", slug="ur5-ik-fsm")], ignore_index=True)
+    info["bands"] = [{"experiment": "sweep", "parameter": "k | gain", "range": "0.8-1.2", "why": "datasheet"}]
+    context = report.paper_context(info, banded, runs, [section], [], tmp_path, tmp_path / "report")
+    html = report.render("paper.html.j2", **context)
+    assert "band [0.8, 1.2]" in html and 'id="band-sweep"' in html and "datasheet" in html
+    assert_tables_whole(html, "paper.html (bands)")
+    markdown_rows_whole(report.render("paper.md.j2", **context), "paper.md (bands)")
+    assert not report.undeclared_bands(info, banded) and report.undeclared_bands({**info, "bands": []}, banded)
     index = report.index_context([(info, evaluated, runs)])
     assert_tables_whole(report.render("index.html.j2", **index), "index.html")
     markdown_rows_whole(report.render("index.md.j2", **index), "index.md")

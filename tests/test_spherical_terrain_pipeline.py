@@ -11,7 +11,9 @@ from .conftest import run_cli
 
 def test_paths_and_a_short_physics_check_to_report(data_dir):
     for args in (["experiment=spherical-terrain/paths"],
-                 ["experiment=spherical-terrain/physics-check", "system.duration=2", "scenario.classes=[rt,rs]"]):
+                 ["experiment=spherical-terrain/physics-check", "system.duration=2", "scenario.classes=[rt,rs]"],
+                 ["-m", "experiment=spherical-terrain/gain-search", "scenario.paths=[diamond]",
+                  "system.controller.class_rs.k_alpha=1,4"]):
         proc = run_cli("pipeline", *args, f"data_dir={data_dir}", "progress=false")
         assert proc.returncode == 0, proc.stderr
     proc = run_cli("analysis", f"data_dir={data_dir}")         # every experiment with runs, then the report
@@ -23,6 +25,17 @@ def test_paths_and_a_short_physics_check_to_report(data_dir):
     assert (status[status.index.str.startswith("path.")] == "match").all()
     assert status["converge.3r-circle"] == "match" and status["agility.vertex"] == "match"
     assert "Physics check" in (data_dir / "report" / "spherical-terrain.md").read_text()
+    # the gain search is the band of the RS-SR targets; its unit-gain run is the default run, batched alone
+    search = pd.read_parquet(data_dir / "metrics/spherical-terrain/gain-search.parquet")
+    paths = pd.read_parquet(data_dir / "metrics/spherical-terrain/paths.parquet")
+    unit = search[search["run_id"].str.startswith("rs-diamond__") & search["run_id"].str.contains("k_alpha=1")]
+    default = paths[paths["run_id"] == "rs-diamond"]
+    for metric in ("error_after_40s.rms", "tilt.max_abs"):
+        assert unit.loc[unit["metric"] == metric, "value"].item() == default.loc[default["metric"] == metric,
+                                                                                 "value"].item()
+    assert search.loc[search["metric"] == "pairs", "value"].item() == 2
+    band = mine.loc["converge.rs-diamond"]
+    assert band["band_min"] <= band["pipeline_value"] <= band["band_max"]
     runs = run_files(data_dir / "runs/spherical-terrain/paths")
     assert len(runs) == 8
     run = read_run(runs[0])

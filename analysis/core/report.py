@@ -16,6 +16,9 @@ What a paper declares for its page, in `analysis/papers/<module>/paper.yaml`:
     slug, title, authors, venue, doi (bare, e.g. 10.3390/robotics11060137), summary
     assumptions: list of {what, choice, config}        what the paper leaves out, and what we chose
     errata:      list of {where, printed, corrected, config}
+    bands:       list of {experiment, parameter, range, why}   every sensitivity band its targets.csv names
+                 (analysis/core/targets.py): the sweep experiment, the parameter the paper omits, the range
+                 swept, and why that range (physics, datasheet, the paper's hints), fixed before the result
     figures:                                           every figure its analysis saves, keyed by
       <experiment>/<file stem>:                        the path under data/figures/<slug>/ without extension
         paper: Fig. 8                                  the paper figure or table it regenerates (null: none)
@@ -30,6 +33,8 @@ The columns of targets.csv (one row per target of every paper):
     slug, target_id, category, quantity, where   the paper and the target (analysis/core/targets.py)
     paper_value, op                              the paper's printed value and how it is compared
     pipeline_value                               the pipeline's value in the paper's unit (empty: none)
+    band_min, band_max                           the band of a target with a sensitivity band (targets.py), in
+                                                 the paper's unit (empty: no band, or its sweep is not on disk)
     deviation, relative_deviation                pipeline − paper, and that over |paper|
     unit, mode, basis, tolerance                 as declared in the paper's targets.csv
     status                                       match | close | consistent | miss | not run | not-reproducible,
@@ -61,8 +66,8 @@ from analysis.core.targets import CATEGORIES, CAUSE_MEANING, CAUSES, STATUS_MEAN
 from pipeline.core import files, provenance
 
 TARGETS_CSV_COLUMNS = ["slug", "target_id", "category", "quantity", "where", "paper_value", "op", "pipeline_value",
-                       "deviation", "relative_deviation", "unit", "mode", "basis", "tolerance", "status", "cause",
-                       "note", "experiment", "run"]
+                       "band_min", "band_max", "deviation", "relative_deviation", "unit", "mode", "basis",
+                       "tolerance", "status", "cause", "note", "experiment", "run"]
 FURTHER = "further results"
 SELF_STATUSES = ("agrees", "disagrees", "not run")
 ROOT = Path(__file__).resolve().parents[2]
@@ -170,6 +175,7 @@ def _target_rows(part: pd.DataFrame, data_dir: Path, report_dir: Path) -> list[d
             "status_rank": STATUS_RANK.get(t.status, 99), "cause": t.cause, "quantity": t.quantity, "where": t.where,
             "paper": f"{OP_SIGN.get(t.op, '')}{paper}" if paper != "" else "", "paper_sort": paper,
             "pipeline": _fmt(t.pipeline_value), "pipeline_sort": _fmt(t.pipeline_value),
+            "band": _band_text(t), "band_anchor": anchor("band", t.band) if getattr(t, "band", "") else "",
             "deviation": _signed(t.deviation), "relative": _signed(t.relative_deviation, relative=True),
             "relative_sort": "" if math.isnan(t.relative_deviation) else f"{abs(t.relative_deviation):.6g}",
             "unit": t.unit, "tolerance": t.tolerance, "basis": t.basis, "mode": t.mode, "note": t.note,
@@ -177,6 +183,36 @@ def _target_rows(part: pd.DataFrame, data_dir: Path, report_dir: Path) -> list[d
             "run_href": _run_href(data_dir, report_dir, t.slug, t.experiment, t.run) if t.experiment else "",
             "command_anchor": anchor("run", t.experiment) if t.experiment else ""})
     return rows
+
+
+def _band_text(t) -> str:
+    """`[min, max]` of a target's band, `not run` if its sweep is not on disk, empty without a band."""
+    if not getattr(t, "band", ""):
+        return ""
+    if math.isnan(t.band_min):
+        return "not run"
+    return f"[{t.band_min:.4g}, {t.band_max:.4g}]"
+
+
+def band_entries(info: dict, evaluated: pd.DataFrame) -> list[dict]:
+    """The bands paper.yaml declares, each with the targets that read it and their [min, max]."""
+    entries = []
+    for b in info.get("bands") or []:
+        of = evaluated[evaluated["band"] == b["experiment"]] if "band" in evaluated else evaluated.iloc[:0]
+        entries.append({**{k: str(b.get(k, "")) for k in ("experiment", "parameter", "range", "why")},
+                        "anchor": anchor("band", b["experiment"]), "run_anchor": anchor("run", b["experiment"]),
+                        "targets": [{"target_id": t.target_id, "anchor": anchor("t", t.target_id),
+                                     "band": _band_text(t), "unit": t.unit, "status": t.status}
+                                    for t in of.itertuples(index=False)]})
+    return entries
+
+
+def undeclared_bands(info: dict, evaluated: pd.DataFrame) -> list[str]:
+    """Bands a paper's targets name that its paper.yaml does not justify under `bands:`."""
+    declared = {b.get("experiment") for b in info.get("bands") or []}
+    named = sorted(set(evaluated["band"]) - {""} - declared) if "band" in evaluated else []
+    return [f"{info['slug']}: band {b} is named in targets.csv but not declared in paper.yaml (bands: experiment, "
+            "parameter, range, why)" for b in named]
 
 
 def figure_entries(info: dict, figures: list[Path], report_dir: Path) -> list[dict]:
@@ -243,6 +279,9 @@ def paper_context(info: dict, evaluated: pd.DataFrame, runs: pd.DataFrame, secti
     causes = Counter(reproduction.loc[reproduction["status"].isin(["miss", "close"]), "cause"])
     toc = [("summary", "Summary"), ("runs", "Runs and commands")]
     toc += [(c["anchor"], f"Paper vs pipeline: {c['title'].lower()}") for c in categories]
+    bands = band_entries(info, evaluated)
+    if bands:
+        toc.append(("bands", "Sensitivity bands"))
     if not consistency.empty:
         toc.append(("self-consistency", "The paper against itself"))
     if further["figures"] or further["sections"]:
@@ -258,7 +297,7 @@ def paper_context(info: dict, evaluated: pd.DataFrame, runs: pd.DataFrame, secti
                                 "consistency": {s: n for s in SELF_STATUSES
                                                 if (n := int((consistency["status"] == s).sum()))},
                                 "causes": {k: causes[k] for k in CAUSES if causes[k]}},
-        "runs": run_rows, "failed_runs": failed_runs, "categories": categories,
+        "runs": run_rows, "failed_runs": failed_runs, "categories": categories, "bands": bands,
         "consistency": _target_rows(consistency, data_dir, report_dir), "further": further, "notes": notes,
         "status_counts": [(s, status_counts[s]) for s in (*STATUSES, *SELF_STATUSES[:2]) if status_counts[s]],
         "revision": provenance.git_revision(),

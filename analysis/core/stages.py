@@ -26,7 +26,7 @@ import pandas as pd
 from analysis.core import report
 from analysis.core.figures import Figures
 from analysis.core.metrics import read_metrics, write_metrics
-from analysis.core.targets import evaluate, load_targets
+from analysis.core.targets import evaluate, load_targets, self_check
 from pipeline.core import files
 from pipeline.core.experiment import available_experiments, module_name
 from pipeline.core.runlog import Run, read_run, run_files
@@ -87,9 +87,11 @@ def _runs_table(metrics_dir: Path) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True)
 
 
-def write_report(data_dir: Path) -> Path:
+def write_report(data_dir: Path) -> tuple[Path, list[str]]:
+    """Every page, the index and targets.csv; and the report's self-check: what its declarations get wrong (a
+    band paper.yaml does not justify, a banded miss whose cause the band rules out: targets.self_check)."""
     report_dir = data_dir / "report"
-    pages, all_evaluated = [], []
+    pages, all_evaluated, problems = [], [], []
     for slug in analyzed_slugs():
         package = paper_package(slug)
         package_dir = Path(package.__file__).parent
@@ -104,13 +106,15 @@ def write_report(data_dir: Path) -> Path:
                                                                   data_dir, report_dir))
         pages.append((info, evaluated, runs))
         all_evaluated.append(evaluated)
+        problems += report.undeclared_bands(info, evaluated) + self_check(evaluated)
     report.write_targets_csv(all_evaluated, report_dir / "targets.csv")
-    return report.write_index(report_dir, report.index_context(pages))
+    return report.write_index(report_dir, report.index_context(pages)), problems
 
 
 def run(data_dir: Path, experiment: str | None, stage: str) -> int:
-    """Analyze the experiments that have runs, then write the report; 1 if nothing could be analysed or an
-    experiment's analysis failed (the others are still analysed)."""
+    """Analyze the experiments that have runs, then write the report; 1 if nothing could be analysed, an
+    experiment's analysis failed (the others are still analysed) or the report's self-check found a problem
+    (the report is still written, with every problem named on stderr)."""
     experiments = [experiment] if experiment else [e for e in available_experiments()
                                                    if e.split("/")[0] in analyzed_slugs()]
     failed = 0
@@ -141,5 +145,9 @@ def run(data_dir: Path, experiment: str | None, stage: str) -> int:
             print(f"error: no metrics under {data_dir / 'metrics'}: python -m analysis data_dir={data_dir} "
                   "analyses the runs first", file=sys.stderr)
             return 1
-        print(f"wrote {write_report(data_dir)}", file=sys.stderr)
+        index, problems = write_report(data_dir)
+        print(f"wrote {index}", file=sys.stderr)
+        for problem in problems:
+            print(f"error: report self-check: {problem}"[:600], file=sys.stderr)
+        failed += len(problems)
     return 1 if failed else 0

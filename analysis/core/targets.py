@@ -3,7 +3,7 @@
 Each paper has `analysis/papers/<module>/targets.csv` with one row per reported number:
 
     target_id, category, quantity, where, value, unit, mode, op, tolerance, basis, cause,
-    experiment, run, metric, note
+    experiment, run, metric, band, note
 
 - `target_id`: unique in the paper (letters, digits, `.`, `-`, `_`); the report anchors each row by it
 - `category`: trajectories | tracking errors | force errors | compute times (the report's summary columns)
@@ -27,18 +27,39 @@ Each paper has `analysis/papers/<module>/targets.csv` with one row per reported 
 - `experiment`, `run`, `metric`: where the pipeline's value is found in data/metrics/<slug>/<experiment>.parquet
   (`run` is a run id, or the id of an aggregate the analysis writes, e.g. `surface`); `metric` is in SI;
   `unit` is the paper's, and the pipeline value is converted to it for the comparison
+- `band`: empty, or the name of an experiment of the same paper whose runs are a disclosed sweep of a parameter
+  the paper omits (a Hydra `-m` sweep in dvc.yaml; see "Sensitivity bands" below)
 - `note`: the rule, assumption or evidence behind the row; for a miss or close, the evidence for its cause
 - `qualitative` targets compare a metric that is 1 when the stated rule holds, 0 when not
 
 Statuses (STATUS_MEANING says each in one sentence; the report prints them):
   match        within the tolerance, or the inequality holds
   close        outside the tolerance but within CLOSE_FACTOR × it (an inequality: fails by at most its margin)
-  consistent   the paper's value lies inside the band the pipeline value spans over a disclosed sweep of a
-               parameter the paper omits (never merged with match; not assigned yet)
+  consistent   the default run misses or is close, and the paper's value lies inside the band the pipeline value
+               spans over a disclosed sweep of a parameter the paper omits (never merged with match)
   miss         farther off, or no pipeline value although its run was made (a failed run says why)
   not run      the target's run is not in this data_dir (its experiment, or that run of it, was not run)
   not-reproducible  hardware only: nothing to compute
 Statuses of a `consistency` row: agrees / disagrees (the same rule as match / miss), or not run.
+
+Sensitivity bands. Where a reported number depends on a parameter the paper omits, we sweep it:
+- the sweep is an experiment of its own (`<name>` in dvc.yaml with `args: "-m key=a,b,c ..."`); its run ids are
+  `<case>__k=v,…` (pipeline/core/runner.py: run_id);
+- the target names that experiment in `band`. Its band is [min, max] of the target's `metric` (converted to the
+  target's unit) over every ok run of the band experiment whose run id is the target's `run` or starts with
+  `<run>__` (band_runs); band_min, band_max are NaN when no such run is on disk;
+- the default run (`experiment`, `run`) stays the pipeline value and is judged as above. If it is a miss or a
+  close and the band reaches the paper's value, the status is `consistent` (the declared cause is kept:
+  usually `parameter-missing`). "Reaches": for `==` the paper's value lies in [min, max]; for `<`, `<=` the
+  claim holds at the band's min, for `>`, `>=` at its max (some parameter in the range satisfies it);
+- if the band cannot reach the paper's value, the status stays as judged and the declared cause must be
+  `model-limitation` or `paper-inconsistent` with the reason in the note (BAND_CAUSES): the parameter the paper
+  omits does not explain the gap. `self_check` lists every target that breaks this rule; the report stage prints
+  them and fails;
+- the paper's `paper.yaml` declares every band experiment under `bands:` as {experiment, parameter, range, why}:
+  the range fixed from physics, datasheets or the paper's own hints before looking at the result (`why` says
+  so, and the range is never adjusted afterwards). The report shows [min, max] beside the default value and
+  lists the bands with their justification. A default is never tuned to hit a paper number.
 """
 
 from __future__ import annotations
@@ -60,6 +81,7 @@ BASES = ("simulation", "algorithm", "paper")
 CAUSES = ("paper-inconsistent", "parameter-missing", "hardware-only", "model-limitation", "open")
 STATUSES = ("match", "close", "consistent", "miss", "not run", "not-reproducible")
 CONSISTENCY_STATUSES = ("agrees", "disagrees", "not run")
+BAND_CAUSES = ("model-limitation", "paper-inconsistent")  # of a banded miss or close: the band cannot reach
 CLOSE_FACTOR = 2.0  # `close`: outside the tolerance, within twice it
 STATUS_MEANING = {
     "match": "the pipeline's value is within the tolerance of the paper's, or the paper's inequality holds.",
@@ -81,7 +103,7 @@ CAUSE_MEANING = {
     "open": "not yet understood",
 }
 COLUMNS = ["target_id", "category", "quantity", "where", "value", "unit", "mode", "op", "tolerance", "basis",
-           "cause", "experiment", "run", "metric", "note"]
+           "cause", "experiment", "run", "metric", "band", "note"]
 
 
 @dataclass(frozen=True)
@@ -119,6 +141,10 @@ def load_targets(path: Path) -> pd.DataFrame:
     if not mixed.empty:
         raise ValueError(f"{path}: {mixed['target_id'].tolist()}: basis `paper` goes with mode `consistency`, "
                          "and only with it (arithmetic on printed numbers is not a reproduction)")
+    banded = targets[(targets["band"] != "") & ~targets["mode"].isin(["exact", "relative", "bound", "qualitative"])]
+    if not banded.empty:
+        raise ValueError(f"{path}: {banded['target_id'].tolist()}: a band belongs to a reproduction target "
+                         "(not to a consistency or not-reproducible row)")
     dupes = targets["target_id"][targets["target_id"].duplicated()].tolist()
     if dupes:
         raise ValueError(f"{path}: duplicate target ids {dupes}")
@@ -168,6 +194,47 @@ def judge(pipeline: float, paper: float, op: str, tol: Tolerance) -> str:
 SELF_CHECK = {"match": "agrees", "close": "disagrees", "miss": "disagrees"}
 
 
+def band_runs(run_ids: pd.Series, run: str) -> pd.Series:
+    """Which run ids belong to the band of a target whose default run is `run`: `run` itself and its sweep
+    runs `<run>__k=v,…` (a run named `<run>-x` or `<run>x` is another case)."""
+    return (run_ids == run) | run_ids.str.startswith(f"{run}__")
+
+
+def band(table: pd.DataFrame | None, ok_runs: set[str], run: str, metric: str, unit: str) -> tuple[float, float]:
+    """[min, max] of `metric` (in `unit`) over the ok runs of a band experiment that belong to `run`; NaN, NaN
+    when none is on disk."""
+    if table is None or table.empty:
+        return math.nan, math.nan
+    rows = table[band_runs(table["run_id"].astype(str), run) & (table["metric"] == metric)
+                 & table["run_id"].isin(ok_runs)]
+    values = [convert(float(v), u, unit) for v, u in zip(rows["value"], rows["unit"], strict=True)]
+    values = [v for v in values if not math.isnan(v)]
+    return (min(values), max(values)) if values else (math.nan, math.nan)
+
+
+def reaches(low: float, high: float, paper: float, op: str) -> bool:
+    """Whether a band [low, high] reaches the paper's value: inside it for `==`; for an inequality, the claim
+    holds at the band's favourable end."""
+    if math.isnan(low) or math.isnan(high):
+        return False
+    if op == "==":
+        return low <= paper <= high
+    return {"<": low < paper, "<=": low <= paper, ">": high > paper, ">=": high >= paper}[op]
+
+
+def self_check(evaluated: pd.DataFrame) -> list[str]:
+    """What the report must refuse: a target with a band (on disk) that misses or is close although its band
+    cannot reach the paper's value, and whose cause is not one of BAND_CAUSES (a missing parameter that does
+    not explain the gap is not the cause)."""
+    if "band" not in evaluated:
+        return []
+    bad = evaluated[(evaluated["band"] != "") & evaluated["status"].isin(["miss", "close"])
+                    & evaluated["band_min"].notna() & ~evaluated["cause"].isin(BAND_CAUSES)]
+    return [f"{r.slug}:{r.target_id}: {r.status} with cause `{r.cause}`, and its band {r.band} "
+            f"[{r.band_min:.4g}, {r.band_max:.4g}] {r.unit} does not reach the paper's {r.op} {r.paper_value}: "
+            f"declare {' or '.join(BAND_CAUSES)} with the reason" for r in bad.itertuples()]
+
+
 def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
              runs: pd.DataFrame | None = None) -> pd.DataFrame:
     """One row per target with the pipeline's value (in the paper's unit), its deviation and a status.
@@ -177,6 +244,10 @@ def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
     failed say why."""
     runs = pd.DataFrame(columns=["experiment", "run_id", "status"]) if runs is None else runs
     made = {(r.experiment, r.run_id) for r in runs.itertuples()}
+    ok_runs: dict[str, set[str]] = {}
+    for r in runs.itertuples():
+        if r.status == "ok":
+            ok_runs.setdefault(r.experiment, set()).add(str(r.run_id))
     failed = {(r.experiment, r.run_id): r.status for r in runs.itertuples() if r.status != "ok"}
     rows = []
     for t in targets.itertuples(index=False):
@@ -185,7 +256,8 @@ def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
                "where": t.where, "paper_value": t.value, "op": t.op, "pipeline_value": float("nan"),
                "deviation": float("nan"), "relative_deviation": float("nan"), "unit": t.unit, "mode": t.mode,
                "basis": t.basis, "tolerance": str(tol), "status": "not-reproducible", "cause": "", "note": t.note,
-               "experiment": t.experiment, "run": t.run}
+               "experiment": t.experiment, "run": t.run, "band": getattr(t, "band", ""),
+               "band_min": math.nan, "band_max": math.nan}
         if t.mode == "not reproducible":
             row["cause"] = t.cause   # as declared: the hardware, a missing parameter, ...
         else:
@@ -213,6 +285,14 @@ def evaluate(slug: str, targets: pd.DataFrame, metrics: dict[str, pd.DataFrame],
                 row["deviation"] = deviation(value, paper, tol)
                 row["relative_deviation"] = row["deviation"] / abs(paper) if paper else float("nan")
                 row["status"] = judge(value, paper, t.op, tol)
+            if row["band"]:
+                low, high = band(metrics.get(row["band"]), ok_runs.get(row["band"], set()), t.run, t.metric,
+                                 t.unit)
+                row["band_min"], row["band_max"] = low, high
+                if row["status"] in ("miss", "close") and not math.isnan(row["pipeline_value"]) and reaches(
+                        low, high, float(t.value), t.op):
+                    row["status"] = "consistent"
+                    row["cause"] = t.cause
             if t.mode == "consistency":
                 row["status"] = SELF_CHECK.get(row["status"], row["status"])
                 if row["status"] == "disagrees":

@@ -13,7 +13,8 @@ _TO_SI_FACTOR = {
     "rad/s": 1.0, "deg/s": 180.0 / math.pi, "rad/s^2": 1.0,
     "m/s": 1.0, "mm/s": 1e3, "m/s^2": 1.0,
     "s": 1.0, "ms": 1e3, "us": 1e6, "ns": 1e9,
-    "N": 1.0, "N*m": 1.0, "Nm": 1.0, "kg": 1.0, "W": 1.0, "J": 1.0, "Hz": 1.0,
+    "N": 1.0, "N*m": 1.0, "Nm": 1.0, "kg": 1.0, "g": 1e3, "W": 1.0, "J": 1.0, "Hz": 1.0,
+    "Pa": 1.0, "MPa": 1e-6, "USD": 1.0,
     "%": 100.0, "fraction": 1.0,
 }
 _DIMENSION = {
@@ -21,6 +22,7 @@ _DIMENSION = {
     "m": "L", "mm": "L", "cm": "L", "um": "L", "m^2": "L2", "mm^2": "L2", "m^3": "L3", "mm^3": "L3",
     "rad": "A", "deg": "A", "mrad": "A", "rad/s": "A/T", "deg/s": "A/T",
     "s": "T", "ms": "T", "us": "T", "ns": "T", "m/s": "L/T", "mm/s": "L/T", "%": "1", "fraction": "1",
+    "kg": "M", "g": "M", "Pa": "P", "MPa": "P",
 }
 
 

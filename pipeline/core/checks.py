@@ -139,7 +139,7 @@ def check_config(cfg: DictConfig, defaults: DictConfig, limits: dict[str, Limit 
         allowed = declared(limits, key)
         choice, text, interval = _of(OneOf, allowed), _of(Text, allowed), _of(Range, allowed)
         if choice is not None and value not in choice:
-            hint = difflib.get_close_matches(str(value), choice.values, n=1)
+            hint = difflib.get_close_matches(str(value), [str(v) for v in choice.values], n=1)
             raise BadInput(f"{key}={_short(value)} is not allowed: must be {choice}"
                            + (f" (did you mean '{hint[0]}'?)" if hint else ""))
         if text is not None and isinstance(value, str) and len(value) > text.max_chars:

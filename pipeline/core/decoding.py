@@ -25,6 +25,7 @@ from mcap.records import Chunk
 from mcap.stream_reader import ReadDataStream, get_chunk_data_stream
 from mcap_protobuf.decoder import DecoderFactory
 
+from pipeline.core import robot
 from pipeline.core.encoding import series_layout
 
 MESSAGE_OPCODE = 0x05
@@ -40,11 +41,12 @@ def _is_repeated(fd: FieldDescriptor) -> bool:
 
 
 @functools.cache
-def _plan(descriptor: Descriptor) -> tuple[bool, tuple[tuple[str, bool, bool], ...]]:
-    """(labels entries by `name`, [(field, repeated, is_message)]) without the timestamp."""
+def _plan(descriptor: Descriptor) -> tuple[bool, tuple[tuple[str, bool, bool, bool], ...]]:
+    """(labels entries by `name`, [(field, repeated, is_message, optional scalar)]) without the timestamp."""
     name = descriptor.fields_by_name.get("name")
     labelled = name is not None and _is_repeated(name)
-    fields = tuple((fd.name, _is_repeated(fd), fd.message_type is not None) for fd in descriptor.fields
+    fields = tuple((fd.name, _is_repeated(fd), fd.message_type is not None,
+                    fd.message_type is None and not _is_repeated(fd) and fd.has_presence) for fd in descriptor.fields
                    if not (fd.message_type is not None and fd.message_type.full_name == "google.protobuf.Timestamp")
                    and not (labelled and fd.name == "name"))
     return labelled, fields
@@ -56,7 +58,9 @@ def flatten(message: Message, prefix: str, row: dict[str, Any]) -> None:
     their `child_frame_id`/`name` if they carry one."""
     labelled, fields = _plan(message.DESCRIPTOR)
     names = list(message.name) if labelled else None
-    for field_name, repeated, is_message in fields:
+    for field_name, repeated, is_message, optional in fields:
+        if optional and not message.HasField(field_name):
+            continue  # an optional field left out (a joint's velocity) is no column, not a zero
         value = getattr(message, field_name)
         key = prefix + field_name
         if repeated and is_message:
@@ -105,10 +109,10 @@ class _Layout:
     def __init__(self, cls: type[Message], first: Message, payload: bytes):
         self.ok = False
         _, fields = _plan(cls.DESCRIPTOR)
-        if any(is_message for _, _, is_message in fields):
+        if any(is_message or optional for _, _, is_message, optional in fields):
             return
         by_name = cls.DESCRIPTOR.fields_by_name
-        doubles = {f for f, _, _ in fields if by_name[f].type == FieldDescriptor.TYPE_DOUBLE}
+        doubles = {f for f, *_ in fields if by_name[f].type == FieldDescriptor.TYPE_DOUBLE}
         constant = {f: getattr(first, f) for f in by_name if f not in doubles and _has(first, by_name[f])}
         repeated = {f: list(getattr(first, f)) for f in doubles if _is_repeated(by_name[f]) and getattr(first, f)}
         scalars = {f: getattr(first, f) for f in doubles if not _is_repeated(by_name[f])}
@@ -129,7 +133,7 @@ class _Layout:
                 self.message = dtype
                 self.record = np.dtype(RECORD_HEADER + [(n, *dtype.fields[n][:1]) for n in dtype.names])
                 self.fixed = [n for n in dtype.names if n.startswith(("c_", "h_"))]
-                self.doubles = [f for f, _, _ in fields if f in per_sample]
+                self.doubles = [f for f, *_ in fields if f in per_sample]
                 return
 
     def read(self, data: bytes, start: int, channel: int, reference: np.ndarray | None) -> np.ndarray | None:
@@ -173,8 +177,8 @@ def _read_topic(f, summary, channel_id: int, decode) -> pd.DataFrame | None:
     if payload is None:
         return None
     first = decode(payload)
-    layout = _Layout(type(first), first, payload)
-    if layout.ok:
+    layout = _Layout(type(first), first, payload) if isinstance(first, Message) else None
+    if layout is not None and layout.ok:
         blocks, reference = [], None
         for data, (start, _) in zip(chunks, starts, strict=True):
             block = layout.read(data, start, channel_id, reference) if start >= 0 else None
@@ -187,8 +191,11 @@ def _read_topic(f, summary, channel_id: int, decode) -> pd.DataFrame | None:
     messages = [m for data in chunks for m in _walk(data, channel_id)[1]]
     rows = []
     for _, data in messages:
-        row: dict[str, Any] = {}
-        flatten(decode(data), "", row)
+        decoded, row = decode(data), {}
+        if isinstance(decoded, dict):
+            row.update(decoded)
+        else:
+            flatten(decoded, "", row)
         rows.append(row)
     index = pd.Index(np.array([t for t, _ in messages], dtype=np.int64) / 1e9, name="t")
     return pd.DataFrame.from_records(rows, index=index).sort_index(kind="stable")
@@ -217,11 +224,20 @@ def _fast_frame(records: np.ndarray, layout: _Layout, first: Message) -> pd.Data
     return _frame(records["log_time"], ordered)
 
 
+class _Ros2StringDecoder:
+    """Decodes the ROS 2 `std_msgs/msg/String` channels (`/robot_description`) as a one-field message."""
+
+    def decoder_for(self, message_encoding: str, schema):
+        if message_encoding == "cdr" and schema is not None and schema.name == robot.ROS2_STRING[0]:
+            return lambda payload: {"data": robot.decode_ros2_string(payload)}
+        return None
+
+
 def read_topics(path: str | Path, topics: Iterable[str]) -> dict[str, pd.DataFrame]:
     """Topic -> DataFrame indexed by simulated time `t` (s), for each of `topics` the file has."""
     wanted = set(topics)
     frames: dict[str, pd.DataFrame] = {}
-    factory = DecoderFactory()
+    factories = (DecoderFactory(), _Ros2StringDecoder())
     with open(path, "rb") as f:
         summary = make_reader(f).get_summary()
         if summary is None:
@@ -229,7 +245,8 @@ def read_topics(path: str | Path, topics: Iterable[str]) -> dict[str, pd.DataFra
         for channel_id, channel in summary.channels.items():
             if channel.topic not in wanted:
                 continue
-            decode = factory.decoder_for(channel.message_encoding, summary.schemas[channel.schema_id])
+            schema = summary.schemas[channel.schema_id]
+            decode = next(d for d in (f.decoder_for(channel.message_encoding, schema) for f in factories) if d)
             frame = _read_topic(f, summary, channel_id, decode)
             if frame is not None:
                 frames[channel.topic] = frame

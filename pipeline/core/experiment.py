@@ -65,13 +65,13 @@ class Range:
 class OneOf:
     """The allowed values of a choice parameter (each element, for a list)."""
 
-    values: tuple[str, ...]
+    values: tuple[str | int, ...]
 
     def __contains__(self, x: object) -> bool:
         return x in self.values
 
     def __str__(self) -> str:
-        return "one of " + ", ".join(self.values)
+        return "one of " + ", ".join(map(str, self.values))
 
 
 @dataclass(frozen=True)

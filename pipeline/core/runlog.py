@@ -25,7 +25,7 @@ from mcap.reader import make_reader
 from mcap.records import Chunk
 from mcap.stream_reader import ReadDataStream, get_chunk_data_stream
 
-from pipeline.core import files, schemas
+from pipeline.core import files, layouts, robot, schemas
 from pipeline.core.decoding import entry_labels, read_topics
 from pipeline.core.encoding import encode_series
 from pipeline.robotics.transforms import quaternion_wxyz
@@ -33,6 +33,7 @@ from pipeline.robotics.transforms import quaternion_wxyz
 RUN_SUFFIX = ".mcap"
 METADATA_NAME = "run"
 CONFIG_ATTACHMENT = "config.yaml"
+MODEL_ATTACHMENT = "model.xml"   # the generated MuJoCo model (MJCF) a run simulates
 CHUNK_BYTES = 1024 * 1024
 UNITS_KEY = "units"   # channel metadata: JSON column -> unit
 # Topics that carry the simulated state: a NaN or an infinity there means the simulation diverged, and the
@@ -42,6 +43,10 @@ STATE_TOPICS = ("/joint_state", "/tracking_error", "/wrench", "/command")
 
 class SimulationFailed(RuntimeError):
     """A run that cannot go on (divergence, NaN, solver breakdown); recorded as `failed: <reason>`."""
+
+
+def _schema_name(kind: type[Message] | tuple) -> str:
+    return kind[0] if isinstance(kind, tuple) else kind.DESCRIPTOR.full_name
 
 
 def _is_state(topic: str) -> bool:
@@ -157,11 +162,14 @@ class RunWriter:
             self._partial, allow_overwrite=True, context=self._context,
             writer_options=MCAPWriteOptions(chunk_size=CHUNK_BYTES, compression_threads=0))
         self._open = True
-        self._types: dict[str, type[Message]] = {}
+        self._types: dict[str, type[Message] | tuple] = {}  # protobuf class, or robot.ROS2_STRING
         self._pending: dict[str, list[tuple[np.ndarray, list[bytes]]]] = {}
         self._units: dict[str, dict[str, str]] = {}   # topic -> column -> unit, written as channel metadata
         self._declared: set[tuple] = set()
         self.metadata = {k: v if isinstance(v, str) else json.dumps(v) for k, v in metadata.items()}
+        self._model_xml: str | None = None
+        self._joint_state: tuple[np.ndarray, list[str], np.ndarray] | None = None
+        self.robot = None  # the RobotDescription drawn, once log_robot has run
 
     # -- messages ---------------------------------------------------------------------------------
     @staticmethod
@@ -171,7 +179,7 @@ class RunWriter:
             raise KeyError(f"{topic} is not a common topic: pass its message_type")
         return cls
 
-    def _queue(self, topic: str, message_type: type[Message]) -> list[tuple[np.ndarray, list[bytes]]]:
+    def _queue(self, topic: str, message_type: type[Message] | tuple) -> list[tuple[np.ndarray, list[bytes]]]:
         known = self._types.get(topic)
         if known is None:
             expected = schemas.for_topic(topic)
@@ -180,8 +188,7 @@ class RunWriter:
             self._types[topic] = message_type
             self._pending[topic] = []
         elif known is not message_type:
-            raise TypeError(f"topic {topic} carries {known.DESCRIPTOR.full_name}, not "
-                            f"{message_type.DESCRIPTOR.full_name}")
+            raise TypeError(f"topic {topic} carries {_schema_name(known)}, not {_schema_name(message_type)}")
         return self._pending[topic]
 
     def write(self, topic: str, t_ns: int, message: Message) -> None:
@@ -220,6 +227,9 @@ class RunWriter:
             _watch(topic, np.asarray(times, dtype=float), per_sample)
         self._declare(topic, cls, {**constant, **{k: v[0] if len(v) else v for k, v in per_sample.items()}},
                       units, field_units)
+        if topic == "/joint_state" and "position" in per_sample and self._joint_state is None:
+            self._joint_state = (np.asarray(times, dtype=float), list(constant.get("name", [])),
+                                 np.asarray(per_sample["position"], dtype=float).reshape(len(times_ns), -1))
         encoded = encode_series(cls, constant, per_sample)
         if encoded is None:
             rows = {k: v.tolist() for k, v in per_sample.items()}
@@ -250,29 +260,93 @@ class RunWriter:
         """Foxglove FrameTransforms: `matrices` (N, k, 4, 4) are the poses of the k `children` in
         `parent` at each of the N `times` (s). Foxglove's 3D panel and Rerun draw them as a frame tree."""
         matrices = np.asarray(matrices, dtype=float)
-        quats = quaternion_wxyz(matrices[..., :3, :3]).tolist()
-        trans = matrices[..., :3, 3].tolist()
         times_ns = seconds_to_ns(np.asarray(times, dtype=float))
-        # one message, updated in place per sample: building k nested messages anew costs 4x more
-        msg = schemas.FrameTransforms(transforms=[schemas.FrameTransform(parent_frame_id=parent, child_frame_id=c)
-                                                  for c in children])
-        items = list(msg.transforms)
-        encoded = []
-        for t_ns, positions, rotations in zip(times_ns.tolist(), trans, quats, strict=True):
-            seconds, nanos = divmod(t_ns, 1_000_000_000)
-            for item, p, q in zip(items, positions, rotations, strict=True):
-                item.timestamp.seconds, item.timestamp.nanos = seconds, nanos
-                tr, rot = item.translation, item.rotation
-                tr.x, tr.y, tr.z = p
-                rot.w, rot.x, rot.y, rot.z = q
-            encoded.append(msg.SerializeToString())
+        encoded = robot.frame_transforms(times_ns, [parent] * len(children), children, matrices[..., :3, 3],
+                                         quaternion_wxyz(matrices[..., :3, :3]))
         self._queue(topic, schemas.FrameTransforms).append((times_ns, encoded))
         known = self._units.setdefault(topic, {})
         for c in children:
             known.update({f"transforms.{c}.translation.{a}": "m" for a in "xyz"})
             known.update({f"transforms.{c}.rotation.{a}": "1" for a in "xyzw"})
 
+    @property
+    def model_xml(self) -> str | None:
+        """The MuJoCo model attached as `model.xml`, if any."""
+        return self._model_xml
+
+    def log_robot(self, times: np.ndarray, qpos: np.ndarray, mocap_pos: np.ndarray | None = None,
+                  mocap_quat: np.ndarray | None = None, model=None) -> None:
+        """Draw the simulated robot: its URDF on `/robot_description` (and as attachment `robot.urdf`), its
+        joints on `/joint_states` and its links on `/tf/robot` (pipeline.core.robot), from MuJoCo states
+        `qpos` (N, nq) at `times` (s) and the world poses of mocap bodies, `mocap_pos` (N or 1, nmocap, 3) and
+        `mocap_quat` (N or 1, nmocap, 4, wxyz; default: as in the model). `model` (`MjModel` or MJCF) defaults
+        to the attached `model.xml`. Call it again to append a later part of the same run; samples are
+        thinned to robot.VIEW_RATE_HZ."""
+        import mujoco
+
+        from pipeline.robotics.urdf import describe
+
+        model = model if model is not None else self._model_xml
+        if model is None:
+            raise ValueError("log_robot: no model given and no model.xml attached")
+        if isinstance(model, str):
+            model = mujoco.MjModel.from_xml_string(model)
+        times = np.atleast_1d(np.asarray(times, dtype=float))
+        keep = robot.thinned(times)
+        mocap_body = model.body_mocapid >= 0
+        defaults = (model.body_pos[mocap_body], model.body_quat[mocap_body])
+        mocap = [np.broadcast_to(default if a is None else a, (len(times), model.nmocap, default.shape[1]))[keep]
+                 for a, default in zip((mocap_pos, mocap_quat), defaults, strict=True)]
+        description = describe(model)
+        if self.robot is None:
+            self.robot = description
+            urdf = description.urdf()
+            self.attach(robot.URDF_ATTACHMENT, urdf, "application/xml")
+            first = seconds_to_ns(times[:1])
+            self._queue(robot.ROBOT_DESCRIPTION, robot.ROS2_STRING).append((first, [robot.ros2_string(urdf)]))
+            fixed = description.fixed
+            if fixed:
+                self._queue(robot.ROBOT_TF, schemas.FrameTransforms).append((first, robot.frame_transforms(
+                    first, [j.parent for j in fixed], [j.child for j in fixed],
+                    np.stack([j.origin.p for j in fixed])[None], np.stack([j.origin.q for j in fixed])[None])))
+        elif self.robot.urdf() != description.urdf():
+            raise ValueError("log_robot: a run draws one robot; this model differs from the first one")
+        if not description.movable:
+            return
+        positions = description.joint_positions(np.atleast_2d(qpos)[keep], *mocap)
+        times_ns = seconds_to_ns(times[keep])
+        self._queue(robot.JOINT_STATES, schemas.JointStates).append(
+            (times_ns, robot.joint_states(times_ns, description.joint_names, positions)))
+        trans, quats = description.transforms(positions)
+        self._queue(robot.ROBOT_TF, schemas.FrameTransforms).append((times_ns, robot.frame_transforms(
+            times_ns, [j.parent for j in description.movable], [j.child for j in description.movable],
+            trans, quats)))
+
+    def _robot_from_joint_state(self) -> None:
+        """A run that attached its MuJoCo model and logged `/joint_state` under the model's joint names gets
+        its robot drawn without asking (joints it did not log stay at qpos0). Models with free, ball or
+        mocap bodies need the full state: call `log_robot`."""
+        import mujoco
+
+        if self.robot is not None or self._model_xml is None or self._joint_state is None:
+            return
+        model = mujoco.MjModel.from_xml_string(self._model_xml)
+        if model.nmocap or any(int(t) in (mujoco.mjtJoint.mjJNT_FREE, mujoco.mjtJoint.mjJNT_BALL)
+                               for t in model.jnt_type):
+            return
+        times, names, position = self._joint_state
+        columns = {name: k for k, name in enumerate(names)}
+        joints = [model.joint(j).name for j in range(model.njnt)]
+        if not joints or not set(joints) <= set(columns):
+            return
+        qpos = np.tile(model.qpos0, (len(times), 1))
+        for j, name in enumerate(joints):
+            qpos[:, model.jnt_qposadr[j]] = position[:, columns[name]]
+        self.log_robot(times, qpos, model=model)
+
     def attach(self, name: str, data: bytes | str, media_type: str) -> None:
+        if name == MODEL_ATTACHMENT:
+            self._model_xml = data if isinstance(data, str) else data.decode()
         self._writer.attach(log_time=0, create_time=0, name=name, media_type=media_type,
                             data=data.encode() if isinstance(data, str) else data)
 
@@ -284,11 +358,17 @@ class RunWriter:
     # -- lifecycle --------------------------------------------------------------------------------
     def _flush_topics(self) -> None:
         for topic, parts in self._pending.items():
-            cls = self._types[topic]
-            channel = foxglove.Channel(topic, schema=foxglove.Schema(
-                name=cls.DESCRIPTOR.full_name, encoding="protobuf", data=_file_descriptor_set(cls.DESCRIPTOR)),
-                message_encoding="protobuf", context=self._context,
-                metadata={UNITS_KEY: json.dumps(self._units[topic])} if self._units.get(topic) else None)
+            kind = self._types[topic]
+            if isinstance(kind, tuple):  # a ROS 2 message (mixed encodings in one file are part of MCAP)
+                name, encoding, definition, message_encoding = kind
+                schema = foxglove.Schema(name=name, encoding=encoding, data=definition)
+            else:
+                schema = foxglove.Schema(name=kind.DESCRIPTOR.full_name, encoding="protobuf",
+                                         data=_file_descriptor_set(kind.DESCRIPTOR))
+                message_encoding = "protobuf"
+            units = self._units.get(topic)
+            channel = foxglove.Channel(topic, schema=schema, message_encoding=message_encoding, context=self._context,
+                                       metadata={UNITS_KEY: json.dumps(units)} if units else None)
             times = np.concatenate([t for t, _ in parts])
             data = [b for _, chunk in parts for b in chunk]
             if len(times) > 1 and (np.diff(times) < 0).any():
@@ -302,6 +382,11 @@ class RunWriter:
 
     def close(self, status: str) -> Path:
         """Record the status, finish the file and publish it under its final name."""
+        if status == "ok":
+            self._robot_from_joint_state()
+        if self._pending:
+            self.attach(layouts.LAYOUT_ATTACHMENT, layouts.foxglove_layout(self._pending, self.metadata.get("slug")),
+                        "application/json")
         self._flush_topics()
         self._writer.write_metadata(METADATA_NAME, {**self.metadata, "status": status})
         self._writer.close()

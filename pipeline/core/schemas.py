@@ -10,10 +10,14 @@ A paper that needs a record the common schemas cannot hold declares it with `def
 
 from __future__ import annotations
 
+from foxglove_schemas_protobuf.ArrowPrimitive_pb2 import ArrowPrimitive
 from foxglove_schemas_protobuf.Color_pb2 import Color
+from foxglove_schemas_protobuf.CubePrimitive_pb2 import CubePrimitive
 from foxglove_schemas_protobuf.CylinderPrimitive_pb2 import CylinderPrimitive
 from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
 from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
+from foxglove_schemas_protobuf.JointStates_pb2 import JointStates
+from foxglove_schemas_protobuf.LinePrimitive_pb2 import LinePrimitive
 from foxglove_schemas_protobuf.Point3_pb2 import Point3
 from foxglove_schemas_protobuf.Pose_pb2 import Pose
 from foxglove_schemas_protobuf.PosesInFrame_pb2 import PosesInFrame
@@ -172,7 +176,8 @@ TOPICS: dict[str, type[Message]] = {
     "/compute_time": ComputeTime,
     "/tf": FrameTransforms,
     "/poses": PosesInFrame,
-    "/markers": SceneUpdate,   # shapes to draw (spheres, cylinders, …) attached to /tf frames
+    "/markers": SceneUpdate,   # shapes to draw (spheres, cylinders, arrows, …) attached to /tf frames
+    "/joint_states": JointStates,  # the robot's joints for Foxglove's URDF layer (pipeline.core.robot)
 }
 
 
@@ -185,9 +190,10 @@ def for_topic(topic: str) -> type[Message] | None:
     return None
 
 
-__all__ = ["ENTRY", "TOPICS", "UNITS", "Color", "CylinderPrimitive", "FrameTransform", "FrameTransforms", "Point3",
-           "Pose", "PosesInFrame", "Quaternion", "SceneEntity", "SceneUpdate", "SpherePrimitive",
-           "TriangleListPrimitive", "Vector3", "define", "derive", "for_topic", "per_second", "stamp", "units_of"]
+__all__ = ["ENTRY", "TOPICS", "UNITS", "ArrowPrimitive", "Color", "CubePrimitive", "CylinderPrimitive",
+           "FrameTransform", "FrameTransforms", "JointStates", "LinePrimitive", "Point3", "Pose", "PosesInFrame",
+           "Quaternion", "SceneEntity", "SceneUpdate", "SpherePrimitive", "TriangleListPrimitive", "Vector3", "define",
+           "derive", "for_topic", "per_second", "stamp", "units_of"]
 
 
 def stamp(t_ns: int) -> timestamp_pb2.Timestamp:

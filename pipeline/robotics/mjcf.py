@@ -33,13 +33,17 @@ class ArmDynamics:
 
 def serial_arm(name: str, dh: DH, dyn: ArmDynamics, *, timestep: float, kp: Sequence[float],
                kv: Sequence[float], gravity_compensation: bool = True, base_pos: Sequence[float] = (0.0, 0.0, 0.0),
-               flange_xml: str = "", world_xml: str = "") -> str:
+               flange_xml: str = "", world_xml: str = "", radii: Sequence[float] | None = None,
+               dh_segments: bool = False) -> str:
     """MJCF of a DH arm driven by a joint PD servo per joint, evaluated every physics step.
 
     Controls are [q_ref (n), q̇_ref (n)]: a position actuator (gain kp) and a velocity actuator
     (gain kv) per joint, so the joint torque is kp·(q_ref − q) + kv·(q̇_ref − q̇) (+ gravity
     compensation), clamped to ±torque_limit at the joint. `base_pos` places DH frame 0 in the world;
     `flange_xml` adds elements in the last DH frame (a tool), `world_xml` in the world body (obstacles).
+    `radii` gives each link its own capsule radius (default: `dyn.link_radius`); `dh_segments` draws a link
+    with both d and a as two capsules along z (d) then x (a), the L the DH table describes, instead of one
+    straight capsule between the two origins (the link's mass is split by length).
     """
     n = dh.n
     for label, seq in (("masses", dyn.masses), ("armature", dyn.armature), ("damping", dyn.damping),
@@ -59,11 +63,19 @@ def serial_arm(name: str, dh: DH, dyn: ArmDynamics, *, timestep: float, kp: Sequ
             f'{pad}  <joint name="joint{i + 1}" axis="0 0 1" armature="{dyn.armature[i]:.17g}" '
             f'damping="{dyn.damping[i]:.17g}" actuatorfrcrange="{-dyn.torque_limit[i]:.17g} '
             f'{dyn.torque_limit[i]:.17g}" ref="{-dh.theta_offset[i]:.17g}"/>')
-        if length > 1e-9:
-            body_xml.append(f'{pad}  <geom type="capsule" fromto="0 0 0 {_fmt(seg)}" size="{dyn.link_radius}" '
+        radius = dyn.link_radius if radii is None else radii[i]
+        if dh_segments and abs(dh.a[i]) > 1e-9 and abs(dh.d[i]) > 1e-9:
+            corner = np.array([0.0, 0.0, dh.d[i]])
+            share = abs(dh.d[i]) / (abs(dh.d[i]) + abs(dh.a[i]))
+            body_xml.append(f'{pad}  <geom type="capsule" fromto="0 0 0 {_fmt(corner)}" size="{radius}" '
+                            f'mass="{dyn.masses[i] * share:.17g}"/>')
+            body_xml.append(f'{pad}  <geom type="capsule" fromto="{_fmt(corner)} {_fmt(seg)}" size="{radius}" '
+                            f'mass="{dyn.masses[i] * (1 - share):.17g}"/>')
+        elif length > 1e-9:
+            body_xml.append(f'{pad}  <geom type="capsule" fromto="0 0 0 {_fmt(seg)}" size="{radius}" '
                             f'mass="{dyn.masses[i]:.17g}"/>')
         else:
-            body_xml.append(f'{pad}  <geom type="sphere" size="{dyn.link_radius}" mass="{dyn.masses[i]:.17g}"/>')
+            body_xml.append(f'{pad}  <geom type="sphere" size="{radius}" mass="{dyn.masses[i]:.17g}"/>')
         # child frame: Tz(d) Tx(a) Rx(alpha)
         body_xml.append(f'{pad}  <frame pos="{_fmt(seg)}" quat="{ca:.17g} {sa:.17g} 0 0">')
         if i == n - 1:
@@ -115,6 +127,29 @@ def with_servo_gains(build: Callable[[np.ndarray, np.ndarray], str], q0: np.ndar
     mujoco.mj_fullM(model, data, inertia)
     m, w = np.diag(inertia), 2 * np.pi * bandwidth_hz
     return build(m * w * w, 2 * damping_ratio * m * w)
+
+
+def servo_rollout(xml: str, q_ref: np.ndarray, qd_ref: np.ndarray, times: np.ndarray, *, moving_start: bool = False
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """A whole servoed run in one C call: the model's actuators are the joint servo (controls [q_ref, q̇_ref],
+    as `serial_arm` builds them), started on q_ref[0], at rest or (`moving_start`) already at q̇_ref[0].
+    Returns (states, sensors), one row per step, each the state after the step (full physics state: time,
+    qpos, qvel, …)."""
+    import mujoco
+    from mujoco import rollout
+
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    data.qpos[:] = q_ref[0]
+    if moving_start:
+        data.qvel[:] = qd_ref[0]
+    mujoco.mj_forward(model, data)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    state0 = np.empty(mujoco.mj_stateSize(model, spec))
+    mujoco.mj_getState(model, data, state0, spec)
+    states, sensors = rollout.rollout(model, data, state0, np.concatenate([q_ref, qd_ref], axis=1)[None])
+    check_mujoco(data, states[0], times)
+    return states[0], sensors[0]
 
 
 # MuJoCo does not return NaN when a simulation blows up: it warns and resets the state. These warnings

@@ -6,9 +6,13 @@ import numpy as np
 
 
 def rotation_angle(R_a: np.ndarray, R_b: np.ndarray) -> np.ndarray:
-    """Geodesic angle (rad) between rotation matrices, batched."""
-    cos = (np.trace(np.swapaxes(R_a, -1, -2) @ R_b, axis1=-2, axis2=-1) - 1.0) / 2.0
-    return np.arccos(np.clip(cos, -1.0, 1.0))
+    """Geodesic angle (rad) between rotation matrices, batched: atan2(sin, cos) of M = R_aᵀ R_b, with sin from
+    M's skew part and cos from its trace, accurate near 0 and near π alike (the arccos of the trace alone gives
+    2e-8 rad for matrices equal to round-off)."""
+    M = np.swapaxes(R_a, -1, -2) @ R_b
+    skew = np.stack([M[..., 2, 1] - M[..., 1, 2], M[..., 0, 2] - M[..., 2, 0], M[..., 1, 0] - M[..., 0, 1]], -1)
+    cos = (np.trace(M, axis1=-2, axis2=-1) - 1.0) / 2.0
+    return np.arctan2(np.linalg.norm(skew, axis=-1) / 2.0, cos)
 
 
 def quaternion_wxyz(R: np.ndarray) -> np.ndarray:

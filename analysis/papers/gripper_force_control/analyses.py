@@ -7,7 +7,13 @@ import pandas as pd
 
 from analysis.core.figures import Figures
 from analysis.core.metrics import MetricTable
-from analysis.papers.gripper_force_control.figures import _cycle_figure, _sag_figure, _steady_figure, _surface_figure
+from analysis.papers.gripper_force_control.figures import (
+    _cycle_figure,
+    _friction_band_figure,
+    _sag_figure,
+    _steady_figure,
+    _surface_figure,
+)
 from analysis.papers.gripper_force_control.metrics import (
     OURS,
     SAG_CASES,
@@ -52,26 +58,48 @@ def analyze_force_sag(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return frame
 
 
+def analyze_friction_band(runs: list[Run], figures: Figures) -> pd.DataFrame:
+    """Fig. 8's friction cases over M1's Coulomb friction (a sweep): each run's sag, as force-sag measures it."""
+    m = MetricTable()
+    points = []
+    for run in runs:
+        start, end = motion_window(run)
+        stats = window_stats(run, start, end + SAG_WINDOW)
+        coulomb = float(_config(run, "system", "friction", "m1_coulomb"))
+        m.add_run(run, stats | {"m1_coulomb": (coulomb, "N m")})
+        points.append((run.metadata["case"], coulomb, stats["force_error.sag"][0]))
+    sweep = pd.DataFrame(points, columns=["case", "m1_coulomb", "sag"])
+    if not sweep.empty:
+        _friction_band_figure(sweep, figures)
+    return m.frame()
+
+
 def analyze_force_error_surface(runs: list[Run], figures: Figures) -> pd.DataFrame:
+    """One max |F_f − F_set| per (ω_max, ε_max, F_set) run; the surface's maximum over every point on disk
+    (Fig. 9 mixes forces of 3-5.7 N), and per force."""
     m = MetricTable()
     points = []
     for run in runs:
         sc = _config(run, "scenario")
-        omega, epsilon = float(sc["omega"]), float(sc["epsilon"])
+        omega, epsilon, force = float(sc["omega"]), float(sc["epsilon"]), float(sc["force"])
         # forward and backward rotation, as the experiment scheduled them (reading /reference costs more)
         move = move_duration(sc["angle"], omega, epsilon)
         end = sc["start"] + 2 * move + sc["pause"]
         stats = window_stats(run, sc["start"], end + SURFACE_WINDOW, tracking=False) | simulated_speed(run)
-        m.add_run(run, stats | {"omega": (omega, "rad/s"), "epsilon": (epsilon, "rad/s^2")})
-        points.append((omega, epsilon, stats["force_error.max"][0]))
-    grid = pd.DataFrame(points, columns=["omega", "epsilon", "max_error"])
+        m.add_run(run, stats | {"omega": (omega, "rad/s"), "epsilon": (epsilon, "rad/s^2"),
+                                "force_set": (force, "N")})
+        points.append((omega, epsilon, force, stats["force_error.max"][0]))
+    grid = pd.DataFrame(points, columns=["omega", "epsilon", "force", "max_error"])
     if not grid.empty:
         top = grid.loc[grid["max_error"].idxmax()]
         m.add("surface", "force_error.max", top["max_error"], "N")
         m.add("surface", "force_error.max_at_omega", top["omega"], "rad/s")
         m.add("surface", "force_error.max_at_epsilon", top["epsilon"], "rad/s^2")
+        m.add("surface", "force_error.max_at_force", top["force"], "N")
         m.add("surface", "force_error.min", grid["max_error"].min(), "N")
         m.add("surface", "points", len(grid), "count")
+        for force, part in grid.groupby("force"):
+            m.add("surface", f"force_error.max.F{force:g}", part["max_error"].max(), "N")
         for metric, (value, unit) in error_ratios(top["max_error"]).items():
             m.add("surface", metric, value, unit)
         middle = np.median(np.unique(grid["omega"]))
@@ -136,6 +164,7 @@ def analyze_tables(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
-ANALYSES = {"force-sag": analyze_force_sag, "force-error-surface": analyze_force_error_surface,
+ANALYSES = {"force-sag": analyze_force_sag, "force-sag-friction": analyze_friction_band,
+            "force-error-surface": analyze_force_error_surface,
             "pick-and-place": analyze_pick_and_place, "steady-state": analyze_steady_state,
             "tables": analyze_tables}

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+import yaml
 
 from analysis.core.figures import Figures, paper_hline, paper_vline, plt
 from analysis.core.targets import paper_value
 from analysis.papers.gripper_force_control.metrics import SAG_CASES, SLUG, STEADY_BELOW, _config, grasp_forces
+from pipeline.core.experiment import CONF_DIR
 from pipeline.core.runlog import Run
 
 
@@ -43,34 +45,64 @@ def _sag_figure(runs: list[Run], figures: Figures) -> None:
 
 
 def _surface_figure(grid: pd.DataFrame, figures: Figures) -> None:
-    table = grid.pivot_table(index="epsilon", columns="omega", values="max_error")
+    """The surface (at each (ε, ω) the largest error over the forces run there, as Fig. 9 mixes forces of
+    3-5.7 N) and one map per F_set."""
+    worst = grid.groupby(["epsilon", "omega"], as_index=False)["max_error"].max()
+    table = worst.pivot_table(index="epsilon", columns="omega", values="max_error")
     bound = paper_value(SLUG, "F9.max")
-    vmax = max(bound, grid["max_error"].max())
-    fig = plt.figure(figsize=(11, 4.4))
+    low, vmax = grid["max_error"].min(), max(bound, grid["max_error"].max())
+    forces = sorted(grid["force"].unique())
+    fig = plt.figure(figsize=(5.5 + 4.2 * len(forces), 4.4))
+    panels = 1 + len(forces)
     if table.shape[0] >= 2 and table.shape[1] >= 2 and not table.isna().any().any():
-        ax = fig.add_subplot(1, 2, 1, projection="3d")
+        ax = fig.add_subplot(1, panels, 1, projection="3d")
         W, E = np.meshgrid(table.columns.to_numpy(), table.index.to_numpy())
-        ax.plot_surface(E, W, table.to_numpy(), cmap="viridis", vmin=grid["max_error"].min(), vmax=vmax,
-                        edgecolor="k", lw=0.3)
+        ax.plot_surface(E, W, table.to_numpy(), cmap="viridis", vmin=low, vmax=vmax, edgecolor="k", lw=0.3)
         ax.plot_surface(E, W, np.full_like(E, bound), color="crimson", alpha=0.15)   # the paper's maximum
         ax.set_xlabel("ε_max [rad/s²]")
         ax.set_ylabel("ω_max [rad/s]")
         ax.set_zlabel("max |F_f − F_set| [N]", labelpad=8)
-        ax.set_title(f"simulated surface; red plane: paper's max {bound:g} N", fontsize=9)
-    ax2 = fig.add_subplot(1, 2, 2)
-    sc = ax2.scatter(grid["epsilon"], grid["omega"], c=grid["max_error"], cmap="viridis", s=90,
-                     vmin=grid["max_error"].min(), vmax=vmax)
-    for row in grid.itertuples():
-        ax2.annotate(f"{row.max_error:.2f}", (row.epsilon, row.omega), fontsize=6, ha="center", va="bottom",
-                     xytext=(0, 5), textcoords="offset points")
-    bar = fig.colorbar(sc, ax=ax2, label="max |F_f − F_set| [N]", pad=0.02)
+        ax.set_title(f"worst over F_set = {', '.join(f'{f:g}' for f in forces)} N;\nred plane: paper's max "
+                     f"{bound:g} N", fontsize=9)
+    for k, force in enumerate(forces):
+        part = grid[grid["force"] == force]
+        ax2 = fig.add_subplot(1, panels, 2 + k)
+        sc = ax2.scatter(part["epsilon"], part["omega"], c=part["max_error"], cmap="viridis", s=90, vmin=low,
+                         vmax=vmax)
+        for row in part.itertuples():
+            ax2.annotate(f"{row.max_error:.2f}", (row.epsilon, row.omega), fontsize=6, ha="center", va="bottom",
+                         xytext=(0, 5), textcoords="offset points")
+        ax2.set_xlabel("ε_max [rad/s²]")
+        ax2.set_ylabel("ω_max [rad/s]")
+        ax2.set_title(f"F_set = {force:g} N: {len(part)} grid points, max {part['max_error'].max():.2f} N",
+                      fontsize=9)
+    bar = fig.colorbar(sc, ax=fig.axes[-1], label="max |F_f − F_set| [N]", pad=0.02)
     bar.ax.axhline(bound, color="crimson", lw=2)
     bar.ax.text(1.6, bound, "paper", color="crimson", fontsize=7, va="center", transform=bar.ax.get_yaxis_transform())
-    ax2.set_xlabel("ε_max [rad/s²]")
-    ax2.set_ylabel("ω_max [rad/s]")
-    ax2.set_title(f"{len(grid)} grid points on disk", fontsize=9)
-    fig.subplots_adjust(left=0.02, right=0.93, bottom=0.12, top=0.9, wspace=0.25)
+    fig.subplots_adjust(left=0.02, right=0.95, bottom=0.12, top=0.88, wspace=0.3)
     figures.save(fig, "fig9-force-error-surface", tight=False)
+
+
+def _friction_band_figure(sweep: pd.DataFrame, figures: Figures) -> None:
+    """Fig. 8's sags over M1's Coulomb friction: the band each friction case spans, the paper's sags, the
+    default friction."""
+    fig, ax = plt.subplots(figsize=(7, 3.8))
+    for i, (case, target) in enumerate((("friction", "F8.friction"), ("no-feedforward", "F8.no-ff"))):
+        part = sweep[sweep["case"] == f"{case}-mujoco"].sort_values("m1_coulomb")
+        if part.empty:
+            continue
+        color = f"C{i + 1}"   # the colours of fig8-force-sag
+        ax.plot(part["m1_coulomb"] * 1e3, 100 * part["sag"], "o-", color=color,
+                label=f"{case} (MuJoCo): band {100 * part['sag'].min():.1f}-{100 * part['sag'].max():.1f} %")
+        paper_hline(ax, paper_value(SLUG, target), label=f"paper: {case} {paper_value(SLUG, target):g} %",
+                    color=color)
+    default = float(yaml.safe_load((CONF_DIR / "system" / f"{SLUG}.yaml").read_text())["friction"]["m1_coulomb"])
+    ax.axvline(default * 1e3, color="k", ls=":", lw=1, label=f"default {default * 1e3:g} mN m")
+    ax.set_xlabel("M1 Coulomb friction [mN m] (the swept range, fixed from the drive train's class)")
+    ax.set_ylabel("force sag [% of F_set]")
+    ax.set_title("Fig. 8 band: sag during a 40° rotation over the plausible friction range", fontsize=9)
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
+    figures.save(fig, "fig8-friction-band")
 
 
 def _cycle_figure(runs: list[Run], figures: Figures) -> None:

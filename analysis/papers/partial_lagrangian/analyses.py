@@ -8,7 +8,7 @@ import pandas as pd
 from analysis.core.compute_time import timing_metrics
 from analysis.core.figures import Figures
 from analysis.core.metrics import MetricTable
-from analysis.papers.partial_lagrangian.figures import _chain_figure, _compute_time_figure
+from analysis.papers.partial_lagrangian.figures import _chain_figure, _compute_time_figure, _term_count_figure
 from analysis.papers.partial_lagrangian.metrics import (
     _control_metrics,
     _damped_oscillation,
@@ -20,6 +20,7 @@ from analysis.papers.partial_lagrangian.metrics import (
     energy_scale,
     slope,
     static_equilibrium,
+    term_count_metrics,
 )
 from pipeline.core.runlog import Run
 
@@ -104,6 +105,15 @@ def analyze_compute_time(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
+def analyze_term_counts(runs: list[Run], figures: Figures) -> pd.DataFrame:
+    m = MetricTable()
+    for run in runs:
+        values = term_count_metrics(run)
+        m.add_run(run, values)
+        _term_count_figure(values, figures)
+    return m.frame()
+
+
 def analyze_checks(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     worst: dict[str, float] = {}
@@ -130,4 +140,4 @@ def analyze_checks(runs: list[Run], figures: Figures) -> pd.DataFrame:
 
 ANALYSES = {"one-link": analyze_pendulum, "two-link": analyze_pendulum, "three-link": analyze_pendulum,
             "ten-link": analyze_pendulum, "slider": analyze_slider, "compute-time": analyze_compute_time,
-            "checks": analyze_checks}
+            "term-counts": analyze_term_counts, "checks": analyze_checks}

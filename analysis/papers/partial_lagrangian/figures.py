@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
-from analysis.core.figures import Figures, plt
+from analysis.core.figures import Figures, paper_hline, plt
 from analysis.papers.partial_lagrangian.metrics import (
     KINDS,
     METHODS,
@@ -84,3 +84,32 @@ def _compute_time_figure(curves: dict, figures: Figures, name: str) -> None:
         ax.legend(fontsize=6)
     fig.suptitle("Fig. 5b: cost against the number of links (medians over repeats, one thread)", fontsize=9)
     figures.save(fig, f"{name}-cost")
+
+
+def _term_count_figure(values: dict, figures: Figures) -> None:
+    """Terms of the expanded symbolic equations of motion against n, beside eqs. (28)-(29) and n² + 2n."""
+    links = sorted(int(k.rsplit(".n", 1)[1]) for k in values if k.startswith("sym.all_tau.n"))
+    n = np.array(links)
+    curve = {name: np.array([values[f"{name}.n{k}"][0] for k in links]) for name in
+             ("sym.all_tau", "sym.column", "sym.tau_max", "eq28", "eq29", "sym.half", "sym.entries")}
+    fig, (ax, ax_half) = plt.subplots(1, 2, figsize=(11, 4), width_ratios=[1.4, 1])
+    for k, (ours, paper, label, paper_label) in enumerate((
+            ("sym.all_tau", "eq28", "all τ_ki (= the usual Lagrangian's τ_k)", "paper: eq. (28)"),
+            ("sym.column", "eq29", "column n alone (one of n threads)", "paper: eq. (29)"))):
+        ax.loglog(n, curve[ours], "o-", color=f"C{k}", ms=4, label=label)
+        ax.loglog(n, curve[paper], "--", color=f"C{k}", lw=1, label=paper_label)
+    ax.loglog(n, curve["sym.tau_max"], "o-", color="C2", ms=4, label="largest τ_ki (τ_1n)")
+    ax.loglog(n, n * n + 2.0 * n, "--", color="C2", lw=1, label="paper: n² + 2n terms per τ_ki")
+    ax.set_xlabel("links n")
+    ax.set_ylabel("terms (expanded, symbolic parameters)")
+    ax.set_title("Terms of the equations of motion (SymPy)", fontsize=9)
+    ax.legend(fontsize=7)
+    ax_half.plot(n, curve["sym.half"], "o-", label="differentiation work, partial / usual (terms × coordinates)")
+    ax_half.plot(n, curve["sym.entries"], "s-", label="non-zero entries of Table 1, n(n+1)/2 of n²")
+    paper_hline(ax_half, 0.5, label="paper: 'about half'")
+    ax_half.set_ylim(0, 1.05)
+    ax_half.set_xlabel("links n")
+    ax_half.set_ylabel("partial / usual")
+    ax_half.set_title("'About half' (Sect. 4.2)", fontsize=9)
+    ax_half.legend(fontsize=7, loc="lower left")
+    figures.save(fig, "term-counts")

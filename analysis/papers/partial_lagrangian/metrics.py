@@ -164,3 +164,35 @@ def _timing_table(ct: pd.DataFrame) -> pd.DataFrame:
         per_item = ct[col].dropna().to_numpy() / ct[f"calls.{name}"].dropna().to_numpy()
         rows += [{"kind": kind, "method": method, "n": int(n[1:]), "seconds": s} for s in per_item]
     return pd.DataFrame(rows)
+
+
+def term_count_metrics(run: Run) -> dict[str, tuple[float, str]]:
+    """Per chain of n links (links 1..n): terms of the expanded L and of all τ_ki (the usual Lagrangian's
+    τ_k hold the same terms: no term of one link merges with another's), of column n alone (one thread's share,
+    eq. 29), of the largest τ_ki (τ_1n); the differentiation work, term × coordinate, of the partial
+    Lagrangians (L_i by θ_1..θ_i, θ̇_1..θ̇_i) over the usual one's (L by all 2n), and Table 1's share of
+    non-zero entries; eqs. (28)-(29); the log-log slopes over n ≥ SLOPE_FROM and the ratio at the largest n."""
+    rows = run["/symbolic/terms"].sort_values("link")
+    links = rows["link"].to_numpy().astype(int)
+    lagrangian = rows["lagrangian"].to_numpy().astype(float)
+    tau = rows.filter(regex=r"^tau\[").to_numpy(dtype=float)     # τ_ki of link i's row, k = 1..i (NaN beyond)
+    column, tau_max = np.nansum(tau, axis=1), np.nanmax(tau, axis=1)
+    every = np.cumsum(column)
+    usual_work = 2 * links * np.cumsum(lagrangian)
+    partial_work = np.cumsum(2 * links * lagrangian)
+    eq28, eq29 = paper_term_counts(links)
+    values: dict[str, tuple[float, str]] = {}
+    for k, n in enumerate(links):
+        values |= {f"sym.lagrangian.n{n}": (float(lagrangian[:k + 1].sum()), "count"),
+                   f"sym.all_tau.n{n}": (every[k], "count"), f"sym.column.n{n}": (column[k], "count"),
+                   f"sym.tau_max.n{n}": (tau_max[k], "count"),
+                   f"sym.half.n{n}": (partial_work[k] / usual_work[k], "ratio"),
+                   f"sym.entries.n{n}": ((n + 1) / (2 * n), "ratio"),
+                   f"eq28.n{n}": (float(eq28[k]), "count"), f"eq29.n{n}": (float(eq29[k]), "count"),
+                   f"sym.seconds.link{n}": (float(rows["seconds"].iloc[k]), "s")}
+    for name, curve in (("all_tau", every), ("column", column), ("tau_max", tau_max), ("eq28", eq28), ("eq29", eq29)):
+        values[f"slope.{name}"] = (slope(links.astype(float), curve), "")
+    values["slope_gap.sym"] = (values["slope.all_tau"][0] - values["slope.column"][0], "")
+    values[f"sym.ratio.n{links[-1]}"] = (every[-1] / column[-1], "ratio")
+    values["sym.seconds"] = (float(rows["seconds"].sum()), "s")
+    return values

@@ -11,6 +11,7 @@ from analysis.core.metrics import MetricTable
 from analysis.papers.spherical_terrain.figures import (
     _controls,
     _errors,
+    _gain_search_figure,
     _paths_3d,
     _physics_figure,
     _sweep_figure,
@@ -26,6 +27,7 @@ from analysis.papers.spherical_terrain.metrics import (
     _reference_metrics,
     convergence_summary,
     convergence_time,
+    gain_search,
 )
 from pipeline.core.runlog import Run
 
@@ -68,6 +70,26 @@ def analyze_sweep(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return frame
 
 
+def analyze_gain_search(runs: list[Run], figures: Figures) -> pd.DataFrame:
+    """The disclosed RS-SR gain search: every run's metrics (each is the band of the `paths` RS-SR targets), and
+    per gain pair whether it converges on both paths; the stated rule's pick and the best pair as `search`."""
+    m, _, _ = _per_run(runs)
+    frame = m.frame()
+    table = gain_search(frame, {run.run_id: run for run in runs})
+    if table.empty:
+        return frame
+    m.add("search", "pairs", len(table), "count")
+    m.add("search", "pairs_converging_both", int(table["converges_both"].sum()), "count")
+    for pick in ("chosen", "best"):
+        for row in table[table[pick]].to_dict("records"):
+            for column, value in row.items():
+                if column.startswith(("k_", "circle", "diamond")):
+                    unit = "s" if "tc_" in column else "m" if "error" in column else "1"
+                    m.add("search", f"{pick}.{column}", value, unit)
+    _gain_search_figure(table, figures)
+    return m.frame()
+
+
 def analyze_physics(runs: list[Run], figures: Figures) -> pd.DataFrame:
     """The ball on the MuJoCo height field against the paper's no-slip model (eq. 31) and exact rigid
     rolling, both fed the ball's own measured ω; and closed-loop tracking against the kinematic model."""
@@ -108,4 +130,4 @@ def analyze_physics(runs: list[Run], figures: Figures) -> pd.DataFrame:
 
 
 ANALYSES = {"paths": analyze_paths, "printed": analyze_printed, "sweep": analyze_sweep,
-            "physics-check": analyze_physics}
+            "gain-search": analyze_gain_search, "physics-check": analyze_physics}

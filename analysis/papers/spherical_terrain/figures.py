@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 
 from analysis.core.figures import Figures, paper_hline, paper_vline, plt
 from analysis.core.targets import paper_value
-from analysis.papers.spherical_terrain.metrics import COLOR, LABEL, SLUG, _terrain
+from analysis.papers.spherical_terrain.metrics import CLAIM_TIME, COLOR, LABEL, SLUG, _terrain
 from pipeline.core.runlog import Run
 from pipeline.papers.spherical_terrain.kinematics import CosineTerrain
 from pipeline.papers.spherical_terrain.tracking import CLASSES
@@ -146,6 +147,39 @@ def _sweep_figure(pivot, params: list[str], figures: Figures) -> None:
     ax.set_title(f"Sweep over {', '.join(params)}")
     ax.legend(fontsize=6, ncol=2)
     figures.save(fig, "sweep-convergence-time")
+
+
+def _gain_search_figure(table: pd.DataFrame, figures: Figures) -> None:
+    """RS-SR over the searched gains: convergence time on the circle, and on the diamond the largest error
+    after 40 s (the vicinity it stays in), with the unit default and the search's best pair outlined."""
+    panels = (("circle", "tc_0.1", "t_c(0.1 m) [s] (x: never)", "{:.0f}", (0, 2 * CLAIM_TIME)),
+              ("diamond", "error_after_40s.max", "max error after 40 s [m]", "{:.2f}", (0, None)))
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.9), sharey=True)
+    for ax, (path, metric, label, fmt, (low, high)) in zip(axes, panels, strict=True):
+        grid = table.pivot_table(index="k_phi", columns="k_alpha", values=f"{path}.{metric}", dropna=False)
+        values = grid.to_numpy(dtype=float)
+        image = ax.imshow(np.ma.masked_invalid(values), origin="lower", cmap="viridis_r", vmin=low, vmax=high,
+                          aspect="auto")
+        for (i, j), value in np.ndenumerate(values):
+            ax.text(j, i, "x" if np.isnan(value) else fmt.format(value), ha="center", va="center", fontsize=8,
+                    color="k", bbox={"fc": "w", "ec": "none", "alpha": 0.7, "pad": 1})
+        ax.set_xticks(range(grid.shape[1]), [f"{v:g}" for v in grid.columns])
+        ax.set_yticks(range(grid.shape[0]), [f"{v:g}" for v in grid.index])
+        ax.set_xlabel("k_α")
+        ax.set_title(f"RS-SR, {path}: {label}", fontsize=9)
+        ax.grid(False)
+        fig.colorbar(image, ax=ax, shrink=0.85)
+        for mark, rows, style in (("unit default", table[(table["k_alpha"] == 1) & (table["k_phi"] == 1)],
+                                   {"edgecolor": "k", "ls": ":"}),
+                                  ("best of the search", table[table["best"]], {"edgecolor": "crimson", "ls": "-"})):
+            for row in rows.itertuples():
+                j, i = list(grid.columns).index(row.k_alpha), list(grid.index).index(row.k_phi)
+                ax.add_patch(plt.Rectangle((j - 0.48, i - 0.48), 0.96, 0.96, fill=False, lw=2, label=mark, **style))
+    axes[0].set_ylabel("k_φ")
+    axes[0].legend(fontsize=7, loc="upper left", bbox_to_anchor=(0, -0.15), ncol=2)
+    fig.suptitle(f"Disclosed RS-SR gain search ({len(table)} pairs; converges: t_c(0.1 m) ≤ {CLAIM_TIME:g} s on "
+                 "both paths)", fontsize=10)
+    figures.save(fig, "gain-search")
 
 
 def _physics_figure(traces: list, figures: Figures) -> None:

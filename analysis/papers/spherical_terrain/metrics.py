@@ -150,3 +150,35 @@ RUN_COLUMNS = {"tc_0.1": "t_c(0.1 m) [s]", "tc_0.05": "t_c(0.05 m) [s]", "first_
                "error_after_40s.mean": "mean e (t≥40) [m]", "error_after_40s.rms": "RMS e (t≥40) [m]",
                "error_after_40s.max": "max e (t≥40) [m]", "vertex.max": "max e near vertices [m]",
                "tilt.max_abs": "max |φ| [rad]", "tilt.saturated_fraction": "tilt saturated [fraction]"}
+
+
+GAINS = ("k_alpha", "k_phi")   # RS-SR's gains (eq. 58), searched by the gain-search experiment
+SEARCH_METRICS = ("tc_0.1", "error_after_40s.rms", "error_after_40s.max")
+
+
+def gain_search(frame: pd.DataFrame, runs: dict[str, Run]) -> pd.DataFrame:
+    """One row per RS-SR gain pair on disk: its gains (from the runs' configs), SEARCH_METRICS on each path,
+    whether it converges on both (t_c(0.1 m) ≤ CLAIM_TIME); `chosen`: the disclosed rule's pick (among the
+    pairs that converge on both paths, the smallest diamond RMS error after 40 s, then the smaller gains);
+    `best`: the smallest diamond RMS error of all pairs (what the search found, converging or not)."""
+    rows = {}
+    for run_id, run in runs.items():
+        gains = run.config["system"]["controller"]["class_rs"]
+        key = tuple(float(gains[g]) for g in GAINS)
+        _, path = _case(run)
+        row = rows.setdefault(key, dict(zip(GAINS, key, strict=True)))
+        for metric in SEARCH_METRICS:
+            hit = frame[(frame["run_id"] == run_id) & (frame["metric"] == metric)]["value"]
+            row[f"{path}.{metric}"] = float(hit.iloc[0]) if len(hit) else float("nan")
+    table = pd.DataFrame(list(rows.values()))
+    if table.empty:
+        return table
+    for column in (f"{path}.{metric}" for path in ("circle", "diamond") for metric in SEARCH_METRICS):
+        if column not in table:
+            table[column] = np.nan
+    table["converges_both"] = (table["circle.tc_0.1"] <= CLAIM_TIME) & (table["diamond.tc_0.1"] <= CLAIM_TIME)
+    table = table.sort_values(list(GAINS)).reset_index(drop=True)
+    order = ["diamond.error_after_40s.rms", *GAINS]
+    table["chosen"] = table.index.isin(table[table["converges_both"]].sort_values(order).index[:1])
+    table["best"] = table.index.isin(table.dropna(subset=[order[0]]).sort_values(order).index[:1])
+    return table

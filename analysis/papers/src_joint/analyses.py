@@ -9,7 +9,13 @@ from scipy.spatial.transform import Rotation
 from analysis.core.compute_time import timing_metrics
 from analysis.core.figures import Figures
 from analysis.core.metrics import MetricTable
-from analysis.papers.src_joint.figures import _joint_figures, _obstacle_figures, _pose_figure, _random_figure
+from analysis.papers.src_joint.figures import (
+    _floor_figure,
+    _joint_figures,
+    _obstacle_figures,
+    _pose_figure,
+    _random_figure,
+)
 from analysis.papers.src_joint.metrics import (
     REACHED_ANGLE,
     REACHED_POSITION,
@@ -18,6 +24,8 @@ from analysis.papers.src_joint.metrics import (
     _joint_metrics,
     _reach_metrics,
     _time_below,
+    floor_metrics,
+    loop_metrics,
 )
 from pipeline.core.runlog import Run
 
@@ -68,6 +76,15 @@ def analyze_reach_poses(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
+def analyze_reach_floor(runs: list[Run], figures: Figures) -> pd.DataFrame:
+    """The floor under targets A and B per model form and reading, and the loop that twists a joint."""
+    m = MetricTable()
+    for run in runs:
+        m.add_run(run, loop_metrics(run) if run.metadata["case"] == "eq5-loop" else floor_metrics(run))
+    _floor_figure({run.metadata["case"]: run for run in runs}, figures)
+    return m.frame()
+
+
 def analyze_avoid_obstacles(runs: list[Run], figures: Figures) -> pd.DataFrame:
     m = MetricTable()
     for run in runs:
@@ -94,4 +111,4 @@ def analyze_avoid_obstacles(runs: list[Run], figures: Figures) -> pd.DataFrame:
 
 
 ANALYSES = {"joint-model": analyze_joint_model, "reach-poses": analyze_reach_poses,
-            "avoid-obstacles": analyze_avoid_obstacles}
+            "reach-floor": analyze_reach_floor, "avoid-obstacles": analyze_avoid_obstacles}

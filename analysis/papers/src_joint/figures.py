@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from matplotlib.patches import Patch
 
 from analysis.core.figures import Figures, paper_hline, plt
 from analysis.core.targets import paper_value
@@ -130,3 +131,32 @@ def _obstacle_figures(runs: dict[str, Run], figures: Figures) -> None:
     ax.set_ylabel("closest distance [mm]")
     ax.legend(fontsize=7, ncol=2)
     figures.save(fig, "fig17-clearance")
+
+
+def _floor_figure(runs: dict[str, Run], figures: Figures) -> None:
+    """Left: the position floor under A and B with the orientation matched, per joint-update mode and reading
+    of the target; right: |ε_z| of a joint rolled round a closed loop, literal eq. (5) against exact rolling."""
+    fig, (ax, ax_loop) = plt.subplots(1, 2, figsize=(11, 3.8), width_ratios=[1.3, 1])
+    bars = [(name, mode, reading, rows) for name in ("A", "B") if name in runs
+            for (mode, reading), rows in runs[name]["/reach/floor"].groupby(["mode", "reading"], sort=False)]
+    colors = {"incremental": "C0", "global": "C1"}
+    for k, (_, mode, _, rows) in enumerate(bars):
+        value = 1e3 * rows.loc[rows["weight_m_per_rad"].idxmax(), "position_error_m"]
+        ax.bar(k, value, color=colors[mode], edgecolor="k", lw=0.5)
+        ax.text(k, value, f"{value:.1f}", ha="center", va="bottom", fontsize=7)
+    ax.set_xticks(range(len(bars)), [f"{name}, {reading}, {'exact' if mode == 'incremental' else 'literal'}"
+                                     for name, mode, reading, _ in bars], rotation=40, ha="right", fontsize=7)
+    ax.legend(handles=[Patch(color=colors["incremental"], label="exact rolling (eq. 5 per step)"),
+                       Patch(color=colors["global"], label="eq. 5 read literally (twist allowed)")], fontsize=7)
+    ax.set_ylabel("closest position [mm], orientation matched")
+    ax.set_title("The floor under Table II's targets A, B per reading of its quaternion (0: reachable)", fontsize=9)
+    if "eq5-loop" in runs:
+        q = runs["eq5-loop"]["/eq5/joint_quaternion"]
+        for mode, style in (("plant", "k-"), ("incremental", "C0--"), ("global", "C1-")):
+            ax_loop.plot(q.index, np.abs(q[f"value.{mode}.qz"]), style, label={"plant": "exact rolling plant",
+                         "incremental": "model, eq. 5 per step", "global": "model, eq. 5 literal"}[mode])
+        ax_loop.set_xlabel("time [s] (Ω^B round a square: +x, +y, −x, −y)")
+        ax_loop.set_ylabel("|ε_z| of the joint quaternion q_i")
+        ax_loop.set_title("One joint rolled round a closed loop", fontsize=9)
+        ax_loop.legend(fontsize=7)
+    figures.save(fig, "reach-floor")

@@ -2,12 +2,18 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pandas as pd
+from scipy.spatial.transform import Rotation
 
 from analysis.core.compute_time import timing_metrics
 from analysis.core.errors import error_stats
+from analysis.core.targets import paper_value
 from pipeline.core.runlog import Run
+from pipeline.papers.src_joint.model import rotation
+from pipeline.papers.src_joint.reachability import READINGS, read_quaternion
 
 # "converges to zero" / "reached accurately" (Figs. 13a, 14a, 16), made a rule: final position error below
 # 0.1 mm and final orientation error below 0.05°
@@ -29,11 +35,9 @@ EULER = ["X", "Y", "Z"]
 SIX = ["wx", "wy", "wz", "vx", "vy", "vz"]
 
 
-# eqs. (66), (67): the paper's IK solutions q^r_i, scalar first
-PRINTED_IK = {"A": [[0.7992, 0.1912, -0.5698, 0.0016], [-0.5579, -0.1939, -0.7714, -0.2366],
-                    [0.1270, -0.4998, -0.3887, 0.7636]],
-              "B": [[-0.4558, 0.5135, -0.7261, -0.0367], [-0.0130, -0.6933, 0.0267, -0.7200],
-                    [0.0880, 0.2577, 0.8231, -0.4983]]}
+# eqs. (66), (67): the paper's IK solutions q^r_i for targets A and B, scalar first (read from targets.csv)
+PRINTED_IK = {target: [[paper_value(SLUG, f"{equation}.q{i}.{c}") for c in "wxyz"] for i in (1, 2, 3)]
+              for target, equation in (("A", "eq66"), ("B", "eq67"))}
 
 
 def _columns(frame: pd.DataFrame, prefix: str, names) -> np.ndarray:
@@ -132,3 +136,62 @@ def _reach_metrics(run: Run) -> dict[str, tuple[float, str]]:
 
 def _bars(frame: pd.DataFrame) -> list[str]:
     return sorted({c.rsplit(".", 1)[1] for c in frame.columns})
+
+
+# -- the floor under A and B (reach-floor) ----------------------------------------------------------------------
+
+def floor_metrics(run: Run) -> dict[str, tuple[float, str]]:
+    """Per joint-update mode and reading of the target: the position floor with the orientation matched (the
+    largest weight) and the orientation floor with the position first (the smallest); per mode the floor over
+    every reading; the paper's IK per mode; how far the closed form ever is from the paper's model."""
+    floor = run["/reach/floor"]
+    values: dict[str, tuple[float, str]] = {}
+    for (mode, reading), rows in floor.groupby(["mode", "reading"], sort=False):
+        last, first = rows.loc[rows["weight_m_per_rad"].idxmax()], rows.loc[rows["weight_m_per_rad"].idxmin()]
+        values[f"floor.position.{mode}.{reading}"] = (float(last["position_error_m"]), "m")
+        values[f"floor.orientation.{mode}.{reading}"] = (float(first["orientation_error_rad"]), "rad")
+        values[f"floor.position_at_orientation_floor.{mode}.{reading}"] = (float(first["position_error_m"]), "m")
+    for mode, rows in floor.groupby("mode", sort=False):
+        weight = rows["weight_m_per_rad"] == rows["weight_m_per_rad"].max()
+        values[f"floor.position.{mode}.every_reading"] = (float(rows.loc[weight, "position_error_m"].min()), "m")
+    values["floor.model_difference_max"] = (float(floor["model_difference_m"].max()), "m")
+    ik = run["/reach/ik"].iloc[0]
+    values |= {f"ik.{k.removeprefix('value.')}": (float(v), "m" if k.endswith("position_error") else
+                                                  "rad" if k.endswith("orientation_error") else "1")
+               for k, v in ik.items() if k.startswith("value.")}
+    if run.metadata["case"] in PRINTED_IK:
+        values["paper.solution_orientation_mismatch"] = (printed_solution_mismatch(run), "rad")
+    return values
+
+
+def printed_solution_mismatch(run: Run) -> float:
+    """The paper's own arithmetic: the angle between the orientation its printed IK solutions (66)/(67) compose
+    to by eq. (17) and Table II's target, the smallest over every reading tried (rad): the target as printed,
+    scalar last or conjugated; the solutions scalar first or last, each possibly conjugated, in any order."""
+    name = run.metadata["case"]
+    target = np.asarray(run.config["scenario"]["targets"][name]["quaternion"], dtype=float)
+    targets = [rotation(read_quaternion(target, reading)) for reading in READINGS]
+    best = np.inf
+    for solution_reading in ("printed", "scalar-last"):
+        joints = [read_quaternion(q, solution_reading) for q in PRINTED_IK[name]]
+        for conjugated in itertools.product((False, True), repeat=3):
+            rotations = [rotation(q * np.array([1, -1, -1, -1]) if c else q) for q, c in zip(joints, conjugated,
+                                                                                               strict=True)]
+            for order in itertools.permutations(rotations):
+                composed = order[0] @ order[1] @ order[2]
+                best = min(best, *(float(Rotation.from_matrix(R @ composed.T).magnitude()) for R in targets))
+    return best
+
+
+def loop_metrics(run: Run) -> dict[str, tuple[float, str]]:
+    """The joint rolled round a closed loop: the largest |ε_z| of its rotation per model mode and the plant,
+    and the twist the literal eq. (5) leaves against exact rolling at the end (rad)."""
+    q = run["/eq5/joint_quaternion"]
+    values = {f"eps_z.max_abs.{m}": (float(q[f"value.{m}.qz"].abs().max()), "1")
+              for m in ("incremental", "global", "plant")}
+    end = q.iloc[-1]
+    for mode in ("incremental", "global"):
+        model = Rotation.from_quat([end[f"value.{mode}.q{c}"] for c in "xyzw"])
+        plant = Rotation.from_quat([end[f"value.plant.q{c}"] for c in "xyzw"])
+        values[f"loop.angle_to_plant.{mode}"] = (float((plant.inv() * model).magnitude()), "rad")
+    return values

@@ -201,3 +201,4 @@ def log_gait(log: RunWriter, run: sn.GaitRun, chain: dc.Chain, xml: str, tf_dt: 
     log.log_transforms(t[every], "world", [*(f"segment{i + 1}" for i in range(chain.segments)), "tip",
                                            *(f"curve/{p}" for p in points)],
                        np.concatenate([frames, tip, curve], axis=1))
+    log.log_robot(t[every], run.qpos[every])

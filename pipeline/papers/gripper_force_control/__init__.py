@@ -32,7 +32,8 @@ def __getattr__(name: str):
     if name == "EXPERIMENTS":
         from pipeline.papers.gripper_force_control import experiments
 
-        return {"force-sag": experiments.force_sag, "force-error-surface": experiments.force_error_surface,
+        return {"force-sag": experiments.force_sag, "force-sag-friction": experiments.force_sag,
+                "force-error-surface": experiments.force_error_surface,
                 "pick-and-place": experiments.pick_and_place, "steady-state": experiments.steady_state,
                 "tables": experiments.tables}
     raise AttributeError(name)

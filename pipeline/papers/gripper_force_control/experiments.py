@@ -14,9 +14,9 @@ from dataclasses import replace
 import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
-from pipeline.core import schemas
+from pipeline.core import markers, robot, schemas
 from pipeline.core.experiment import Case
-from pipeline.core.runlog import RunWriter, SimulationFailed
+from pipeline.core.runlog import RunWriter, SimulationFailed, seconds_to_ns
 from pipeline.papers.gripper_force_control import lumped
 from pipeline.papers.gripper_force_control.drive import Schedule, move_duration, schedule
 from pipeline.papers.gripper_force_control.lumped import Start, Trace, static_grasp
@@ -24,6 +24,7 @@ from pipeline.papers.gripper_force_control.model import Gripper, gripper
 from pipeline.papers.gripper_force_control.mujoco_plant import FRAMES, MujocoGripper
 
 JOINTS = ["m1", "m2", "gripper", "finger"]
+FORCE_RGBA, FORCE_SCALE = (0.95, 0.5, 0.1, 1.0), 0.005  # the grasp force drawn at 5 mm/N
 PLANTS = ("mujoco", "lumped")
 
 TableRow = schemas.define(
@@ -59,6 +60,12 @@ def run_plant(log: RunWriter, cfg: DictConfig, p: Gripper, s: Schedule, start: S
         tf_every = max(1, round(cfg.tf_dt / p.dt))
         trace, poses = sim.simulate(s, start, log_every, settle=cfg.mujoco.settle, tf_every=tf_every)
         log.log_transforms(s.t[::tf_every], "world", list(FRAMES), poses)
+        log.log_robot(s.t[::tf_every], np.array(sim.states))
+        t_tf = s.t[::tf_every]
+        force = np.interp(t_tf, trace.t, trace["force"])  # the grasp force, along the pad's x (/wrench frame)
+        for t_k, f_k in zip(t_tf[robot.thinned(t_tf)], force[robot.thinned(t_tf)], strict=True):
+            log.write("/markers", seconds_to_ns(t_k), schemas.SceneUpdate(entities=[markers.arrow(
+                "grasp_force", "pad", [f_k, 0.0, 0.0], FORCE_RGBA, scale=FORCE_SCALE)]))
     elif plant == "lumped":
         trace = lumped.simulate(p, s, start, log_every)
     else:
@@ -120,6 +127,8 @@ def force_sag(cfg: DictConfig) -> list[Case]:
 
     cases = []
     for name, case in sc.cases.items():
+        if case is None:   # dropped by an override (a band sweeps only the cases its parameter acts on)
+            continue
         p = _case_gripper(cfg, case.friction, case.feedforward)
         cases += [Case(f"{name}-{plant}", lambda log, p=p, plant=plant: simulate(log, p, plant)) for plant in sc.plants]
     for form in sc.forms:   # the printed coupling factor / eq. (9) gains, ideal case

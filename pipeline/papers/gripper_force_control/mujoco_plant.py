@@ -144,6 +144,7 @@ class MujocoGripper:
         self.model = mujoco.MjModel.from_xml_string(self.xml)
         self.data = mujoco.MjData(self.model)
         self.qpos = {j: int(self.model.joint(j).qposadr[0]) for j in ("gripper", "finger", "pad")}
+        self.states: list[np.ndarray] = []  # qpos at the /tf samples of the last simulate()
         self.motor = {t: self.model.tendon(t).id for t in ("m1", "m2")}
         self.pad_geom = self.model.geom("pad").id
         self.bodies = [self.model.body(b).id for b in FRAMES]
@@ -184,9 +185,9 @@ class MujocoGripper:
     def simulate(self, s: Schedule, start: Start, log_every: int, settle: float = 0.0,
                  tf_every: int = 0) -> tuple[Trace, np.ndarray]:
         """Run the drive on the model over the schedule from `start`; sample every `log_every` ticks and the
-        body poses every `tf_every` ticks. The first `settle` s (not logged, time starts after them) hold the
-        schedule's first set points with friction off: the soft contact finds its equilibrium, as the lumped
-        plant's exact `start` already is."""
+        body poses (and `states`, qpos) every `tf_every` ticks. The first `settle` s (not logged, time starts
+        after them) hold the schedule's first set points with friction off: the soft contact finds its
+        equilibrium, as the lumped plant's exact `start` already is."""
         import mujoco
 
         from pipeline.robotics.mjcf import check_mujoco
@@ -198,7 +199,7 @@ class MujocoGripper:
         friction = m.dof_frictionloss.copy(), m.tendon_frictionloss.copy()
         m.dof_frictionloss[:], m.tendon_frictionloss[:] = 0.0, 0.0
         rec = np.empty((len(range(0, s.ticks, log_every)), len(TRACE_FIELDS)))
-        frames = []
+        frames, self.states = [], []
         qp, qv, ctrl = d.qpos, d.qvel, d.ctrl
         i_g, i_f = self.qpos["gripper"], self.qpos["finger"]
         k_g, g_f, j, step = p.gear.k_g, p.gear.g_f, 0, mujoco.mj_step
@@ -219,6 +220,7 @@ class MujocoGripper:
                 j += 1
             if tf_every and k >= pre and (k - pre) % tf_every == 0:
                 frames.append(self.poses())
+                self.states.append(qp.copy())
             step(m, d)
         check_mujoco(d, rec, s.t[::log_every])
         return Trace(s.t[::log_every], {name: rec[:, i] for i, name in enumerate(TRACE_FIELDS)}), np.array(frames)

@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
-from pipeline.core import schemas
+from pipeline.core import markers, schemas
 from pipeline.core.experiment import Case
-from pipeline.core.runlog import RunWriter
+from pipeline.core.runlog import RunWriter, seconds_to_ns
 from pipeline.core.timing import log_timings, time_calls
 from pipeline.papers.nmpc_cdkd import kinematics as kin
 from pipeline.papers.nmpc_cdkd import planning
@@ -19,6 +19,7 @@ from pipeline.papers.nmpc_cdkd.plant import KinematicPlant, MujocoPlant, model_x
 from pipeline.papers.nmpc_cdkd.simulation import Controller, Move, Obstacles, Trajectory, closed_loop, run
 
 XYZ = ["x", "y", "z"]
+OBSTACLE_RGBA = (0.85, 0.25, 0.2, 0.6)
 PLANNING_REPEATS = 20
 
 NmpcSolve = schemas.define(
@@ -99,7 +100,8 @@ def log_trajectory(log: RunWriter, arm: Arm, tr: Trajectory, model: str, obstacl
                    names: list[str], offset: float = 0.0) -> None:
     """Write one closed-loop move; `offset` (s) places it after earlier moves of the same run."""
     t = tr.t + offset
-    log.log_series("/joint_state", t, units="rad", name=JOINTS, position=tr.q, velocity=tr.qd, effort=tr.effort)
+    efforts = {"effort": tr.effort} if np.isfinite(tr.effort).all() else {}  # a kinematic plant has none
+    log.log_series("/joint_state", t, units="rad", name=JOINTS, position=tr.q, velocity=tr.qd, **efforts)
     log.log_series("/command", t, units="rad", kind="position", name=JOINTS, value=tr.q_cmd)
     log.log_series("/command/velocity", t, units="rad", kind="velocity", name=JOINTS, value=tr.qd_cmd)
     log.log_series("/reference", t, units="rad", name=JOINTS, position=tr.q_ref, velocity=tr.qd_ref)
@@ -141,7 +143,11 @@ def log_trajectory(log: RunWriter, arm: Arm, tr: Trajectory, model: str, obstacl
         poses[..., :3, 3] = centres
         frames += [poses[:, i] for i in range(len(names))]
         children += [f"obstacle/{n}" for n in names]
+        log.write("/markers", seconds_to_ns(t[0]), schemas.SceneUpdate(entities=markers.spheres(
+            [f"obstacle/{n}" for n in names], obstacles.radii, [OBSTACLE_RGBA] * len(names))))
     log.log_transforms(t, "world", children, np.stack(frames, axis=1))
+    if log.model_xml is not None:  # the MuJoCo plant: draw the arm and its mocap obstacles as simulated
+        log.log_robot(t, tr.q, mocap_pos=tr.centres if len(obstacles) else None)
 
 
 # -- E2-E4: the scene of Figs. 2-7 ------------------------------------------------------------------------

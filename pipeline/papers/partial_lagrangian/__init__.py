@@ -45,7 +45,8 @@ def __getattr__(name: str):
         from pipeline.papers.partial_lagrangian import experiments as ex
 
         return {"one-link": ex.pendulum, "two-link": ex.pendulum, "three-link": ex.pendulum,
-                "ten-link": ex.pendulum, "slider": ex.slider, "compute-time": ex.compute_time, "checks": ex.checks}
+                "ten-link": ex.pendulum, "slider": ex.slider, "compute-time": ex.compute_time,
+                "term-counts": ex.term_counts, "checks": ex.checks}
     if name == "MujocoChain":
         from pipeline.papers.partial_lagrangian.mujoco_chain import MujocoChain
 

@@ -1,8 +1,10 @@
 """Simulate stage of `partial-lagrangian`: the chains of Figs. 1-5a, the slider reconstruction of Fig. 4,
-the compute time of Fig. 5b, and the checks of the AD dynamics against MuJoCo and closed forms."""
+the compute time of Fig. 5b, the symbolic term counts of eqs. (28)-(29), and the checks of the AD dynamics
+against MuJoCo and closed forms."""
 
 from __future__ import annotations
 
+import time
 from functools import partial
 
 import numpy as np
@@ -71,6 +73,7 @@ def log_trajectory(log: RunWriter, cfg: DictConfig, chain: ch.Chain, traj: Traje
     tf = every(cfg, cfg.system.logging.tf_dt)
     log.log_transforms(traj.t[tf], "world", [f"tip{i + 1}" for i in range(chain.n)],
                        ch.pose_matrices(chain, traj.q[tf]))
+    log.log_robot(traj.t[tf], traj.q[tf])  # the attached MuJoCo chain: its qpos are the paper's q
 
 
 def _pd_gains(spec: DictConfig, n: int) -> Gains:
@@ -132,6 +135,28 @@ def slider(cfg: DictConfig) -> list[Case]:
 def random_states(rng: np.random.Generator, n: int, count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(q, q̇, τ), each (count, n): angles over a full turn, rates and torques of the runs' size."""
     return rng.uniform(-np.pi, np.pi, (count, n)), rng.uniform(-3, 3, (count, n)), rng.uniform(-50, 50, (count, n))
+
+
+LinkTermsRow = schemas.define(
+    "PartialLagrangianTerms", "Terms of link i's expanded symbolic partial Lagrangian L_i and of its derivatives "
+    "(k = 1..i): ∂L_i/∂θ_k, ∂L_i/∂θ̇_k, τ_ki = D_k L_i; and the wall time of counting them (s).",
+    link="int64", lagrangian="int64", d_angle="int64[]", d_rate="int64[]", tau="int64[]", seconds="double",
+)
+
+
+def term_counts(cfg: DictConfig) -> list[Case]:
+    """Eqs. (28)-(29) and 'about half' count symbolic terms: count them, link by link (a chain of n links is
+    links 1..n; the counts of a link do not depend on the links after it), with SymPy (symbolic.py)."""
+    from pipeline.papers.partial_lagrangian.symbolic import link_counts
+
+    def simulate_case(log: RunWriter) -> None:
+        for link in range(1, max(cfg.scenario.links) + 1):
+            start = time.perf_counter()
+            terms = link_counts(link - 1)
+            log.log("/symbolic/terms", float(link), LinkTermsRow, link=link, lagrangian=terms.lagrangian,
+                    d_angle=terms.d_angle, d_rate=terms.d_rate, tau=terms.tau, seconds=time.perf_counter() - start)
+
+    return [Case("chains", simulate_case)]
 
 
 def compute_time(cfg: DictConfig) -> list[Case]:
@@ -253,6 +278,7 @@ def checks(cfg: DictConfig) -> list[Case]:
                        velocity=traj.qd[logged])
         log.log_series("/joint_state/mujoco", traj.t[logged], schemas.JointState, units=units, name=names,
                        position=q_mj[logged], velocity=qd_mj[logged])
+        log.log_robot(traj.t[logged], q_mj[logged])
         for integrator in sc.energy_integrators:
             free = simulate(chain.undamped(), q0, np.zeros(chain.n), Gains.free(chain.n), dt, sc.energy_duration,
                             integrator=integrator)

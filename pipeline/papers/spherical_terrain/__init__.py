@@ -57,7 +57,7 @@ def __getattr__(name: str):
         from pipeline.papers.spherical_terrain import experiments, physics
 
         return {"paths": experiments.tracking, "printed": experiments.tracking, "sweep": experiments.tracking,
-                "physics-check": physics.physics_check}
+                "gain-search": experiments.tracking, "physics-check": physics.physics_check}
     raise AttributeError(name)
 
 
@@ -91,4 +91,4 @@ RULES = (
 )
 _STEPS = Budget("steps", lambda c: len(c.scenario.classes) * len(c.scenario.paths) * c.system.duration
                  / c.system.physics.timestep, 2e7, "fewer classes or paths, or a shorter system.duration")
-BUDGETS = dict.fromkeys(("paths", "printed", "sweep", "physics-check"), _STEPS)
+BUDGETS = dict.fromkeys(("paths", "printed", "sweep", "gain-search", "physics-check"), _STEPS)

@@ -218,6 +218,8 @@ def physics_check(cfg: DictConfig) -> list[Case]:
                                                                                     kinematic_tf[:, 1]))
         frames[:, 2, :3, 3] = ball["p_d"][tf, k]
         log.log_transforms(ball["t"][tf], "world", ["sphere", "kinematic_model/sphere", "target"], frames)
+        qpos = np.concatenate([ball["center"][tf], ball["quat"][tf]], axis=-1)  # every ball's free joint
+        log.log_robot(ball["t"][tf], qpos.reshape(len(qpos), -1))
         log_scene(log, m.terrain, s.radius, {"sphere": SHELL_COLOR, "kinematic_model/sphere": GHOST_COLOR})
 
     return [Case(f"{c}-{q}", lambda log, k=k: simulate_case(log, k)) for k, (c, q) in enumerate(pairs)]

@@ -39,7 +39,7 @@ def __getattr__(name: str):
         from pipeline.papers.src_joint import experiments
 
         return {"joint-model": experiments.joint_model, "reach-poses": experiments.reach_poses,
-                "avoid-obstacles": experiments.avoid_obstacles}
+                "reach-floor": experiments.reach_floor, "avoid-obstacles": experiments.avoid_obstacles}
     raise AttributeError(name)
 
 
@@ -55,6 +55,11 @@ LIMITS = {
     **{f"scenario.plants.{plant}.sensing": OneOf(("measured", "encoders"))
        for plant in ("nominal", "encoders", "eva-1mm", "slip-2pct", "eva-1mm-slip-2pct")},
     "scenario.hardware_targets": (Length(0, 2), OneOf(("A", "B"))),
+    "scenario.floor.modes": (Length(1, 2), OneOf(("incremental", "global"))),
+    "scenario.floor.readings": (Length(1, 3), OneOf(("printed", "scalar-last", "conjugate"))),
+    "scenario.floor.weights": (Length(1, 10), Range(gt=0, le=1e6)), "scenario.floor.starts": Range(ge=1, le=4096),
+    "scenario.floor.iterations": Range(ge=1, le=1000),
+    "scenario.loop.rate": Range(gt=0, le=100), "scenario.loop.side": Range(gt=0, le=100),
     "scenario.bars.points": Range(ge=-1, le=1), "scenario.duration": Range(gt=0, le=300),
     "system.ik.dt": STEP, "system.control.dt": STEP, "physics.dt": Range(ge=1e-5, le=0.01),
     "physics.noslip_iterations": Range(ge=0, le=1000), "physics.settle_time": Range(ge=0, le=10),
@@ -89,6 +94,10 @@ BUDGETS = {
     "reach-poses": Budget("IK and control steps", lambda c: (2 + c.scenario.random_targets) * len(c.scenario.plants)
                           * (c.system.ik.duration / c.system.ik.dt + c.scenario.duration / c.system.control.dt),
                           2e6, "fewer scenario.random_targets or shorter durations"),
+    "reach-floor": Budget("configurations evaluated", lambda c: len(c.scenario.floor.modes)
+                          * len(c.scenario.floor.readings) * len(c.scenario.floor.weights) * c.scenario.floor.iterations
+                          * c.scenario.floor.starts * (3 * c.scenario.joints + 2), 5e6,
+                          "fewer scenario.floor.starts or iterations"),
     "avoid-obstacles": Budget("IK steps", lambda c: len(c.scenario.cases) * c.scenario.duration / c.system.ik.dt,
                               1e6, "a shorter scenario.duration or a longer system.ik.dt"),
 }

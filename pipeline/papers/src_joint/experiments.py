@@ -1,6 +1,7 @@
-"""Simulate stage of `src-joint`: the joint model against physics (E1), reaching poses A and B (E2), and
-reaching C between two bars (E3). Every run logs what the analysis needs to redraw Figs. 8-10, 13-14, 16-17
-and a 3-D replay (/tf frames of the spheres, /markers to draw them)."""
+"""Simulate stage of `src-joint`: the joint model against physics (E1), reaching poses A and B (E2), the
+floor under A and B over every model form and reading (E2'), and reaching C between two bars (E3). Every run
+logs what the analysis needs to redraw Figs. 8-10, 13-14, 16-17 and a 3-D replay (/tf frames of the spheres,
+/markers to draw them)."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from scipy.spatial.transform import Rotation
 from pipeline.core import markers, schemas
 from pipeline.core.experiment import Case
 from pipeline.core.runlog import RunWriter, SimulationFailed
+from pipeline.papers.src_joint import reachability as reach
 from pipeline.papers.src_joint import trolley as tr
 from pipeline.papers.src_joint.ik import Bars, Damper, DamperQP, IkGains, IkResult, solve_ik
 from pipeline.papers.src_joint.manipulator import (
@@ -22,7 +24,7 @@ from pipeline.papers.src_joint.manipulator import (
     position_mode,
     velocity_mode,
 )
-from pipeline.papers.src_joint.model import Chain, ModelForm, qlog, quaternion_of, rotation
+from pipeline.papers.src_joint.model import CONVENTIONS, Chain, ModelForm, qlog, quaternion_of, rotation
 from pipeline.papers.src_joint.physics import (
     ContactPhysics,
     JointRecording,
@@ -30,6 +32,7 @@ from pipeline.papers.src_joint.physics import (
     roll_exactly,
     roll_in_mujoco,
 )
+from pipeline.papers.src_joint.rolling import RollingChain
 
 AXES = ["x", "y", "z"]
 SIX_UNITS = ["rad/s", "rad/s", "rad/s", "m/s", "m/s", "m/s"]   # wx, wy, wz, vx, vy, vz
@@ -293,6 +296,102 @@ def reach_poses(cfg: DictConfig) -> list[Case]:
     cases = [(name, "nominal") for name in targets]
     cases += [(name, plant) for name in sc.hardware_targets for plant in sc.plants if plant != "nominal"]
     return [Case(f"{name}-{plant}", lambda log, t=name, p=plant: simulate(log, t, p)) for name, plant in cases]
+
+
+# -- E2': the floor under A and B, and eq. (5)'s literal update (Sec. V-B, eqs. 5, 66-67) -----------------------
+
+FloorRow = schemas.define(
+    "SrcReachFloor", "The closest a 3-joint equal-sphere chain comes to a target pose: one joint-update mode, one "
+    "reading of the target quaternion, one weighting of orientation against position (m per rad), and the most the "
+    "closed-form kinematics differs from the paper's model (every model form) at that configuration (m).",
+    mode="string", reading="string", weight_m_per_rad="double", position_error_m="double",
+    orientation_error_rad="double", model_difference_m="double",
+)
+
+
+def _model_difference(r: np.ndarray, radii: np.ndarray, position: np.ndarray, R: np.ndarray) -> float:
+    """The largest difference between the closed form and the paper's Chain (every model form) at one
+    configuration: end-effector position (m) and rotation matrix entries."""
+    q1, q2 = reach.model_state(r)
+    worst = 0.0
+    for radius_convention in CONVENTIONS:
+        for free_mode_sign in CONVENTIONS:
+            chain = Chain(radii, ModelForm(radius_convention, free_mode_sign), q1, q2)
+            pos, _ = chain.frames()
+            worst = max(worst, float(np.abs(pos[-1] - position).max()),
+                        float(np.abs(rotation(chain.orientation()) - R).max()))
+    return worst
+
+
+def reach_floor(cfg: DictConfig) -> list[Case]:
+    sc, s = cfg.scenario, cfg.system
+    n, radius, f = sc.joints, s.freebot.radius, sc.floor
+    radii = np.full(n + 1, radius)
+
+    def simulate_target(log: RunWriter, name: str) -> None:
+        target = sc.targets[name]
+        r_desired, printed = np.asarray(target.position, dtype=float), np.asarray(target.quaternion, dtype=float)
+        t = 0.0
+        best = None
+        for mode in f.modes:
+            for reading in f.readings:
+                R_desired = rotation(reach.read_quaternion(printed, reading))
+                found = reach.floors(r_desired, R_desired, radius, n, mode, f.weights, f.starts, f.iterations,
+                                     np.random.default_rng(cfg.seed))
+                for fl in found:
+                    pos, R = (a[0, -1] for a in reach.fk(fl.rotvecs[None], radius))
+                    log.log("/reach/floor", t, FloorRow, mode=mode, reading=reading, weight_m_per_rad=fl.weight,
+                            position_error_m=fl.position_error, orientation_error_rad=fl.orientation_error,
+                            model_difference_m=_model_difference(fl.rotvecs, radii, pos, R))
+                    t += 1e-3   # one row per millisecond: a table, not a trajectory
+                if (mode, reading) == ("incremental", "printed"):
+                    best = found[-1]
+        # the paper's own IK (Sec. III-B) in each joint-update mode, from the identity
+        k, ik = s.ik, ik_gains(cfg)
+        rows = []
+        for mode in f.modes:
+            result = solve_ik(Chain(radii, model_form(cfg, joint_update=mode)), r_desired, unit_quaternion(printed),
+                              ik, k.dt, k.duration, k.tol_position, k.tol_orientation, k.stall_time, k.stall_change)
+            rows += [np.linalg.norm(result.position_error[-1]), np.linalg.norm(result.orientation_error[-1]),
+                     float(result.converged), np.abs(result.chain.joint_quaternions()[:, 3]).max()]
+        log.log("/reach/ik", 0.0, schemas.Scalars,
+                name=[f"{m}.{x}" for m in f.modes for x in ("position_error", "orientation_error", "converged",
+                                                           "eps_z_max")], value=rows)
+        if best is not None:   # the closest exact-rolling pose, to look at beside the target
+            pos, rot = reach.fk(best.rotvecs[None], radius)
+            bodies = [f"B{i}" for i in range(n + 1)]
+            target_pose = poses(r_desired, rotation(unit_quaternion(printed)))
+            log.log_transforms(np.zeros(1), "world", [*bodies, "target"],
+                               np.concatenate([poses(pos, rot), target_pose[None, None]], axis=1))
+            log_spheres(log, bodies, [radius] * (n + 1), [BASE_COLOR] + [LINK_COLOR] * n)
+            log.log("/joint_state", 0.0, name=joint_names(n, AXES), position=best.rotvecs.ravel().tolist())
+
+    def simulate_loop(log: RunWriter) -> None:
+        """One joint rolled round a closed square of Ω^B (+x, +y, −x, −y): the model in both joint-update
+        modes beside exact rolling; exact rolling never twists (ε_z = 0), eq. (5) read literally does."""
+        lp, dt = sc.loop, s.control.dt
+        steps = round(lp.side / dt)
+        sides = np.repeat(np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]]) * lp.rate, steps, axis=0)
+        chains = {mode: Chain(radii[:2], model_form(cfg, joint_update=mode)) for mode in reach.MODES}
+        plant = RollingChain(radii[:2])
+        quaternions = np.zeros((len(sides) + 1, 3, 4))
+        for j in range(len(sides) + 1):
+            quaternions[j] = [*(c.joint_quaternions()[0] for c in chains.values()), quaternion_of(plant.relative[0])]
+            if j < len(sides):
+                for c in chains.values():
+                    c.roll(sides[j:j + 1], dt)
+                plant.roll(sides[j:j + 1], dt)
+        quaternions *= np.where(quaternions[..., :1] < 0, -1.0, 1.0)
+        t = np.arange(len(sides) + 1) * dt
+        log.log_series("/joint_state", t, name=[f"{m}.{a}" for m in (*reach.MODES, "plant") for a in AXES],
+                       position=qlog(quaternions).reshape(len(t), -1))
+        log.log_series("/eq5/joint_quaternion", t, schemas.Scalars,
+                       name=[f"{m}.{c}" for m in (*reach.MODES, "plant") for c in ("qw", "qx", "qy", "qz")],
+                       value=quaternions.reshape(len(t), -1))
+        log.log_series("/reference", t[:-1], name=["x", "y"], velocity=sides)
+
+    cases = [Case(name, lambda log, x=name: simulate_target(log, x)) for name in sc.targets]
+    return [*cases, Case("eq5-loop", simulate_loop)]
 
 
 # -- E3: reaching C between two bars (Sec. V-C, Figs. 15-17) ----------------------------------------------------

@@ -16,6 +16,7 @@ from pipeline.core.timing import best_of, time_calls
 from pipeline.papers.ur5_ik_fsm import experiments as ex
 from pipeline.papers.ur5_ik_fsm import ik
 from pipeline.robotics import dh as dhk
+from pipeline.robotics.mjcf import servo_rollout
 
 
 def execution(rows: list[dict]) -> None:
@@ -38,8 +39,8 @@ def execution(rows: list[dict]) -> None:
         for _ in range(steps):
             step(model, data)
 
-    states, sensors = ex.run_servo(xml, q_ref, qd_ref, times)
-    t_bare, t_servo = best_of(bare, 5), best_of(lambda: ex.run_servo(xml, q_ref, qd_ref, times), 5)
+    states, sensors = servo_rollout(xml, q_ref, qd_ref, times)
+    t_bare, t_servo = best_of(bare, 5), best_of(lambda: servo_rollout(xml, q_ref, qd_ref, times), 5)
     system = "MuJoCo UR5, wrist path (4 s, 1 kHz)"
     rows += [
         {"what": system, "measure": "bare mj_step loop", "value": t_bare / steps * 1e6, "unit": "µs/step"},
@@ -56,7 +57,7 @@ def execution(rows: list[dict]) -> None:
                     log.close("ok")
 
             def full() -> None:
-                ex.run_servo(xml, q_ref, qd_ref, times)
+                servo_rollout(xml, q_ref, qd_ref, times)
                 logging_only()
 
             t_full, t_log = best_of(full, 5), best_of(logging_only, 5)

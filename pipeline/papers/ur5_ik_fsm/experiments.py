@@ -17,6 +17,7 @@ from pipeline.core.timing import time_calls
 from pipeline.papers.ur5_ik_fsm import ik
 from pipeline.papers.ur5_ik_fsm.kinematics import Geometry, det_j, fk, shoulder_term
 from pipeline.robotics import dh as dhk
+from pipeline.robotics.mjcf import servo_rollout
 from pipeline.robotics.transforms import rotation_angle
 
 JOINTS = [f"joint{i}" for i in range(1, 7)]
@@ -168,25 +169,6 @@ def arm_model(cfg: DictConfig, g: Geometry, q0: np.ndarray) -> str:
     return with_servo_gains(build, q0, ex.bandwidth_hz, ex.damping_ratio)
 
 
-def run_servo(xml: str, q_ref: np.ndarray, qd_ref: np.ndarray, times: np.ndarray):
-    """The whole servoed run in one C call (the servo is the model's actuators): (states, sensors)."""
-    import mujoco
-    from mujoco import rollout
-
-    from pipeline.robotics.mjcf import check_mujoco
-
-    model = mujoco.MjModel.from_xml_string(xml)
-    data = mujoco.MjData(model)
-    data.qpos[:] = q_ref[0]
-    mujoco.mj_forward(model, data)
-    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    state0 = np.empty(mujoco.mj_stateSize(model, spec))
-    mujoco.mj_getState(model, data, state0, spec)
-    states, sensors = rollout.rollout(model, data, state0, np.concatenate([q_ref, qd_ref], axis=1)[None])
-    check_mujoco(data, states[0], times)
-    return states[0], sensors[0]
-
-
 def log_execution(log: RunWriter, cfg: DictConfig, g: Geometry, times, q_ref, qd_ref, states, sensors,
                   ik_times, poses) -> None:
     """Log the servoed run every `execute.log_dt` (and link frames every `execute.tf_dt`)."""
@@ -225,7 +207,7 @@ def execute(log: RunWriter, cfg: DictConfig, q_ik: np.ndarray, ik_times: np.ndar
                                             cfg.system.dynamics.velocity_limit)
     xml = arm_model(cfg, g, q_ref[0])
     log.attach("model.xml", xml, "application/xml")
-    states, sensors = run_servo(xml, q_ref, qd_ref, times)
+    states, sensors = servo_rollout(xml, q_ref, qd_ref, times)
     log_execution(log, cfg, g, times, q_ref, qd_ref, states, sensors, ik_times, poses)
 
 

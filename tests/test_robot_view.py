@@ -1,0 +1,182 @@
+"""Every robot in 3-D: the URDF generated from the MuJoCo model parses with a maintained URDF library, its FK
+equals MuJoCo's, its joints are the joint-state channel's, the channels decode, the Foxglove layout uses only
+what Foxglove's schema knows, and Rerun's own MCAP loader turns a run into 3-D geometry."""
+
+from __future__ import annotations
+
+import io
+import json
+import shutil
+import subprocess
+
+import mujoco
+import numpy as np
+import pytest
+import yourdfpy
+from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
+
+from pipeline.core import layouts, robot
+from pipeline.core.runlog import RunWriter, read_run
+from pipeline.robotics.urdf import Pose, describe
+
+from .conftest import ENV
+
+# hinge with anchor and ref, slide with ref, ball, free, a geom-less body, a mocap body, capsules: every case
+MODEL = """<mujoco model="demo"><worldbody><geom type="plane" size="1 1 0.1"/>
+<body name="a" pos="0.1 0.2 0.3" quat="0.9 0.1 0.3 0.2"><joint name="h1" axis="0.3 0.4 0.5" pos="0.05 0 0.1" ref="0.4"/>
+ <joint name="s1" type="slide" axis="1 0.2 0" pos="0 0.1 0" ref="0.1" range="-1 1"/>
+ <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.02"/>
+ <body name="b" pos="0.3 0 0" euler="0.3 0.2 0.1"><joint name="ball" type="ball" pos="0.01 0.02 0.03"/>
+  <geom type="box" size="0.1 0.05 0.02"/>
+  <body name="c" pos="0 0 0.2"><joint name="h2" axis="0 1 0" range="-2 2"/><site name="tip" pos="0 0 0.3"/>
+   <inertial pos="0 0 0.1" mass="1" diaginertia="1 1 1"/></body></body></body>
+<body name="f" pos="1 1 1"><freejoint name="fj"/><geom type="sphere" size="0.1"/>
+ <body name="g" pos="0.2 0 0"><joint name="h3" axis="0 0 1"/><geom type="cylinder" size="0.02 0.1"/></body></body>
+<body name="m" mocap="true" pos="0.5 0.5 0.5"><geom type="sphere" size="0.05"/></body>
+</worldbody></mujoco>"""
+
+
+def random_states(model, n: int, seed: int = 0):
+    rng = np.random.default_rng(seed)
+    qpos = rng.uniform(-1.5, 1.5, (n, model.nq))
+    for j in range(model.njnt):
+        a, kind = model.jnt_qposadr[j], model.jnt_type[j]
+        if kind in (mujoco.mjtJoint.mjJNT_BALL, mujoco.mjtJoint.mjJNT_FREE):
+            q = slice(a, a + 4) if kind == mujoco.mjtJoint.mjJNT_BALL else slice(a + 3, a + 7)
+            qpos[:, q] /= np.linalg.norm(qpos[:, q], axis=1, keepdims=True)
+    mocap_pos = rng.uniform(-1, 1, (n, model.nmocap, 3))
+    mocap_quat = rng.normal(size=(n, model.nmocap, 4))
+    return qpos, mocap_pos, mocap_quat / np.linalg.norm(mocap_quat, axis=-1, keepdims=True)
+
+
+def mujoco_poses(model, qpos, mocap_pos, mocap_quat):
+    data = mujoco.MjData(model)
+    out = []
+    for q, mp, mq in zip(qpos, mocap_pos, mocap_quat, strict=True):
+        data.qpos[:], data.mocap_pos[:], data.mocap_quat[:] = q, mp, mq
+        mujoco.mj_kinematics(model, data)
+        out.append((data.xpos.copy(), data.xmat.reshape(-1, 3, 3).copy()))
+    return out
+
+
+def test_urdf_parses_and_its_fk_is_mujocos():
+    model = mujoco.MjModel.from_xml_string(MODEL)
+    description = describe(model)
+    urdf = yourdfpy.URDF.load(io.StringIO(description.urdf()), load_meshes=False, load_collision_meshes=False)
+    assert sorted(urdf.actuated_joint_names) == sorted(description.joint_names)
+    qpos, mocap_pos, mocap_quat = random_states(model, 12)
+    positions = description.joint_positions(qpos, mocap_pos, mocap_quat)
+    for q, (xpos, xmat) in zip(positions, mujoco_poses(model, qpos, mocap_pos, mocap_quat), strict=True):
+        urdf.update_cfg(dict(zip(description.joint_names, q, strict=True)))
+        for b in range(1, model.nbody):
+            T = urdf.get_transform(f"demo/{model.body(b).name}", "world")
+            assert np.allclose(T[:3, 3], xpos[b], atol=1e-9) and np.allclose(T[:3, :3], xmat[b], atol=1e-9)
+
+
+def test_link_transforms_compose_to_mujocos_poses():
+    """/tf/robot (what Rerun and Foxglove place links by) chained from the root equals MuJoCo's FK."""
+    model = mujoco.MjModel.from_xml_string(MODEL)
+    description = describe(model)
+    qpos, mocap_pos, mocap_quat = random_states(model, 5, seed=1)
+    trans, quats = description.transforms(description.joint_positions(qpos, mocap_pos, mocap_quat))
+    for i, (xpos, xmat) in enumerate(mujoco_poses(model, qpos, mocap_pos, mocap_quat)):
+        pose = {"world": Pose.identity()}
+        moving = {j.child: (j.parent, Pose(trans[i, k], quats[i, k])) for k, j in enumerate(description.movable)}
+        moving |= {j.child: (j.parent, j.origin) for j in description.fixed}
+        while len(pose) < len(moving) + 1:
+            for child, (parent, local) in moving.items():
+                if parent in pose and child not in pose:
+                    pose[child] = pose[parent] @ local
+        for b in range(1, model.nbody):
+            p = pose[f"demo/{model.body(b).name}"]
+            R = np.zeros(9)
+            mujoco.mju_quat2Mat(R, p.q)
+            assert np.allclose(p.p, xpos[b], atol=1e-9) and np.allclose(R.reshape(3, 3), xmat[b], atol=1e-9)
+
+
+def test_column_encoding_equals_protobufs():
+    times_ns = np.array([0, 7, 1_500_000_000, 300 * 10**9 + 999])
+    trans, quats = np.random.default_rng(2).normal(size=(4, 2, 3)), np.random.default_rng(3).normal(size=(4, 2, 4))
+    for payload, t, tr, q in zip(robot.frame_transforms(times_ns, ["world", "a"], ["a", "b" * 200], trans, quats),
+                                 times_ns, trans, quats, strict=True):
+        message = FrameTransforms.FromString(payload)
+        assert [x.child_frame_id for x in message.transforms] == ["a", "b" * 200]
+        assert message.transforms[1].timestamp.ToNanoseconds() == t
+        assert np.allclose([[x.translation.x, x.translation.y, x.translation.z] for x in message.transforms], tr)
+        assert np.allclose([[x.rotation.w, x.rotation.x, x.rotation.y, x.rotation.z] for x in message.transforms], q)
+    assert robot.decode_ros2_string(robot.ros2_string("<robot/>")) == "<robot/>"
+
+
+def write_run(path, n: int = 400):
+    model = mujoco.MjModel.from_xml_string(MODEL)
+    qpos, mocap_pos, mocap_quat = random_states(model, n)
+    t = np.arange(n) * 1e-3
+    with RunWriter(path, {"run_id": path.stem, "slug": "demo"}) as w:
+        w.attach("model.xml", MODEL, "application/xml")
+        w.log_series("/tracking_error", t, units="m", name=["x"], error=qpos[:, :1], norm=np.abs(qpos[:, 0]))
+        w.log_robot(t, qpos, mocap_pos, mocap_quat)
+        w.close("ok")
+    return t
+
+
+def test_run_carries_the_robot(tmp_path):
+    t = write_run(tmp_path / "r.mcap")
+    run = read_run(tmp_path / "r.mcap")
+    assert {robot.ROBOT_DESCRIPTION, robot.JOINT_STATES, robot.ROBOT_TF} <= set(run.topic_names)
+    urdf = run["/robot_description"]["data"].iloc[0]
+    assert urdf == run.attachments[robot.URDF_ATTACHMENT].decode()
+    names = sorted(yourdfpy.URDF.load(io.StringIO(urdf), load_meshes=False).actuated_joint_names)
+    states = run["/joint_states"]
+    assert sorted(c.removeprefix("joints.").removesuffix(".name") for c in states.columns
+                  if c.endswith(".name")) == names
+    assert len(states) == len(robot.thinned(t)) < len(t)  # thinned to VIEW_RATE_HZ for drawing
+    assert np.diff(states.index).max() <= 1 / robot.VIEW_RATE_HZ + 1e-12
+
+
+def test_joint_state_names_draw_the_robot_unasked(tmp_path):
+    xml = """<mujoco model="arm"><worldbody><body name="l1"><joint name="j1" axis="0 0 1"/>
+      <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.02"/></body></worldbody></mujoco>"""
+    with RunWriter(tmp_path / "r.mcap", {"run_id": "r"}) as w:
+        w.attach("model.xml", xml, "application/xml")
+        w.log_series("/joint_state", np.arange(3) * 0.1, units="rad", name=["j1"],
+                     position=np.array([[0.0], [0.1], [0.2]]))
+        w.close("ok")
+    states = read_run(tmp_path / "r.mcap")["/joint_states"]
+    assert np.allclose(states["joints.j1.position"], [0.0, 0.1, 0.2])
+
+
+def test_foxglove_layout_is_foxgloves_schema(tmp_path):
+    write_run(tmp_path / "r.mcap", 20)
+    layout = json.loads(read_run(tmp_path / "r.mcap").attachments[layouts.LAYOUT_ATTACHMENT])
+    scene, plots = layout["content"]["items"]
+    three_d = scene["content"]
+    assert three_d["panelType"] == "ThreeDee"
+    urdf = three_d["config"]["layers"]["robot"]
+    assert (urdf["layerId"], urdf["sourceType"], urdf["topic"], urdf["controlMode"], urdf["jointStatesTopic"]) == \
+        ("foxglove.Urdf", "topic", "/robot_description", "jointStates", "/joint_states")
+    [plot] = plots["content"]["items"]
+    assert plot["content"]["config"]["paths"][0]["value"] == "/tracking_error.norm"
+
+
+@pytest.mark.skipif(shutil.which("rerun") is None, reason="rerun CLI (rerun-sdk) not on PATH")
+def test_rerun_mcap_loader_draws_the_robot(tmp_path):
+    write_run(tmp_path / "r.mcap", 50)
+    out = tmp_path / "r.rrd"
+    subprocess.run(["rerun", "mcap", "convert", str(tmp_path / "r.mcap"), "-o", str(out)], check=True, env=ENV,
+                   capture_output=True, timeout=120)
+    printed = subprocess.run(["rerun", "rrd", "print", str(out)], check=True, env=ENV, capture_output=True,
+                             text=True, timeout=120).stdout
+    for geometry in ("Boxes3D", "Cylinders3D", "Ellipsoids3D"):  # the URDF's visuals, not only transforms
+        assert geometry in printed
+    assert "Transform3D:child_frame" in printed
+
+
+def test_view_writes_under_data_views(tmp_path):
+    from analysis import view
+
+    run_dir = tmp_path / "runs" / "demo" / "e"
+    run_dir.mkdir(parents=True)
+    write_run(run_dir / "r.mcap", 30)
+    out = view.convert(run_dir / "r.mcap")
+    assert out == tmp_path / "views" / "demo" / "e" / "r.rrd" and out.stat().st_size > 0
+    assert sorted(p.name for p in run_dir.iterdir()) == ["r.mcap"]
