@@ -107,13 +107,18 @@ def test_randomized_episodes_in_one_process(data_dir):
 @pytest.mark.parametrize(("args", "says"), [
     (["episodes.count=1000000"], "episodes.count=1e+06 is out of range"),
     (["episodes.count=100000", "scenario.duration=60"], "episodes would need about"),
-    (["episodes.count=2", "scenario.algorithms=[alg1,alg2]", "episodes.randomize.scenario.algorithms=null"],
+    (["episodes.count=2", "scenario.algorithms=[alg1,alg2]", "~episodes.randomize.scenario.algorithms"],
      "would make 2 runs"),
-    (["episodes.count=2", "episodes.randomize.execute.bandwidth_hz={normal:[8,2]}"], "a normal needs clip"),
-    (["episodes.count=2", "episodes.randomize.scenario.paths={choice:[[wrist],[knee]]}"],
+    (["episodes.count=2", "~episodes.randomize.execute.bandwidth_hz",
+      "+episodes.randomize.execute.bandwidth_hz={normal:[8,2]}"], "a normal needs clip"),
+    (["episodes.count=2", "episodes.randomize.execute.bandwidth_hz={normal:[8,2]}"], "to replace a distribution"),
+    (["episodes.count=2", "~episodes.randomize.scenario.paths", "+episodes.randomize.scenario.paths={choice:[[knee]]}"],
      "scenario.paths='knee' is not allowed"),
-    (["episodes.count=2", "episodes.randomize.execute.bandwidth_hz={uniform:[4,400]}"],
+    (["episodes.count=2", "episodes.randomize.execute.bandwidth_hz.uniform=[4,400]"],
      "is out of range: must be > 0 and <= 100"),
+    (["episodes.count=2", "+episodes.randomize.execute.bandwith_hz={uniform:[4,8]}"],
+     "did you mean 'execute.bandwidth_hz'"),
+    (["episodes.count=2", "+episodes.randomize.execute.log_dt={uniform:[0.001]}"], "must be [a, b]"),
 ])
 def test_bad_episodes_are_refused_before_anything_runs(args, says):
     with pytest.raises(BadInput, match=says.replace("(", r"\(").replace("+", r"\+").replace("[", r"\[")):

@@ -89,6 +89,8 @@ def _of(kind: type, limits: tuple[Limit, ...]) -> Any:
 
 def _check_shape(value: Any, default: Any, key: str, limits: dict) -> None:
     """A list stays a list (of its default's length, unless declared `Length`), a single value single."""
+    if key == "episodes.randomize":
+        return   # distributions, each checked against the key it draws (check_episodes)
     if isinstance(default, DictConfig):
         for k in default:
             if k in value and not (not key and k == "hydra"):
@@ -238,10 +240,11 @@ def check_episodes(cfg: DictConfig, experiment: Experiment) -> None:
                                f"{', '.join(c.id for c in made[:3])}, ...): an episode is one run; fix or "
                                "randomize the lists that multiply it")
         total += budget.estimate(_Attributes(work)) if budget is not None else 0.0
-    if budget is not None and not total <= budget.limit:
-        raise BadInput(f"{experiment.id}: {count} episodes would need about {total:.3g} {budget.what}, more than "
-                       f"the budget of {budget.limit:.3g}: fewer episodes" + (f", {budget.hint}" if budget.hint
-                                                                              else ""))
+        if budget is not None and not total <= budget.limit:   # said as soon as it is known
+            total *= count / (index + 1)
+            raise BadInput(f"{experiment.id}: {count} episodes would need about {total:.3g} {budget.what}, more "
+                           f"than the budget of {budget.limit:.3g}: fewer episodes"
+                           + (f", {budget.hint}" if budget.hint else ""))
 
 
 class _Attributes(dict):
@@ -342,6 +345,9 @@ def _one_line(err: Exception, overrides: list[str], valid_keys: list[str]) -> st
     text = str(err)
     if "not in struct" in str(root) or "Could not override" in text or "Could not append" in text:
         key = text.split("'")[1] if "'" in text else str(root)
+        if key.startswith("episodes.randomize."):   # struct mode: a distribution is replaced, not merged
+            return (f"{key}: to replace a distribution, remove it and add the new one: ~{key} "
+                    f"'+{key}={{uniform:[a,b]}}'")
         hint = difflib.get_close_matches(key, valid_keys, n=1)
         return f"unknown config key '{key}'" + (f" (did you mean '{hint[0]}'?)" if hint else "")
     if "Could not find" in text or "Could not load" in text:
@@ -385,8 +391,9 @@ def preflight(argv: list[str]) -> None:
                 importlib.util.find_spec("hydra_plugins.hydra_ray_launcher") is None:
             raise BadInput("hydra/launcher=ray needs the Ray launcher: pip install -e '.[ray]'")
         for o in extra:
-            if o.startswith("+") and not o.startswith("+hydra"):
-                raise BadInput(f"adding keys is not allowed ('{o}'): every parameter has a default in conf/")
+            if o.startswith("+") and not o.startswith(("+hydra", "+episodes.randomize.")):
+                raise BadInput(f"adding keys is not allowed ('{o}'): every parameter has a default in conf/ "
+                               "(only distributions are added: +episodes.randomize.<key>={uniform:[a,b]})")
         if experiment_id not in checked:
             defaults = compose_config([f"experiment={experiment_id}"])
             checked[experiment_id] = (defaults, [k for k, _ in _leaves(defaults)], resolve(experiment_id))

@@ -4,11 +4,19 @@ declared in its config, one run file per episode, over the cores.
     episodes:
       count: 1000          # 0: the experiment's own cases; N > 0: N episodes
       workers: 0           # processes (0: one per core)
-      randomize:           # dotted config key -> distribution
-        execute.bandwidth_hz: {uniform: [4, 16]}
-        scenario.wrist.q_mid: {uniform: [-0.2, 0.2], add: true}     # each element: default + U(-0.2, 0.2)
-        scenario.paths: {choice: [[wrist], [shoulder], [elbow]]}
-        system.dynamics.masses: {normal: [1.0, 0.05], clip: [0.9, 1.1], scale: true}   # default × N(1, 0.05)
+      randomize:           # the config's own layout; a distribution where a value was
+        execute:
+          bandwidth_hz: {uniform: [4, 16]}
+        scenario:
+          wrist:
+            q_mid: {uniform: [-0.2, 0.2], add: true}     # each element: default + U(-0.2, 0.2)
+          paths: {choice: [[wrist], [shoulder], [elbow]]}
+        system:
+          dynamics:
+            masses: {normal: [1.0, 0.05], clip: [0.9, 1.1], scale: true}   # default × N(1, 0.05)
+
+On the command line: `+episodes.randomize.execute.damping_ratio={uniform:[0.7,1.2]}` adds one,
+`~episodes.randomize.scenario.paths` removes one (replace one by removing it and adding the new one).
 
 Distributions: uniform [lo, hi], loguniform [lo, hi], integers [lo, hi] (inclusive), normal [mean, std] (with
 clip [lo, hi]: a sample must stay in its range), choice [options]. A list-valued key draws each element (lo and
@@ -44,10 +52,23 @@ def _plain(value: Any) -> Any:
     return OmegaConf.to_container(value, resolve=True) if isinstance(value, DictConfig | ListConfig) else value
 
 
-def randomized(cfg: DictConfig) -> dict[str, dict]:
-    """Key -> its distribution (plain dicts), in key order."""
-    spec = _plain(OmegaConf.select(cfg, "episodes.randomize", default=None)) or {}
-    return {key: spec[key] for key in sorted(spec)}
+def _is_distribution(node: Any) -> bool:
+    return not isinstance(node, Mapping) or any(k in node for k in (*DISTRIBUTIONS, "clip", "add", "scale"))
+
+
+def randomized(cfg: DictConfig) -> dict[str, Any]:
+    """Dotted config key -> its distribution (plain dicts), in key order."""
+    found: dict[str, Any] = {}
+
+    def walk(node: Any, prefix: str) -> None:
+        if prefix and _is_distribution(node):
+            found[prefix] = node
+            return
+        for key, child in node.items():
+            walk(child, f"{prefix}.{key}" if prefix else str(key))
+
+    walk(_plain(OmegaConf.select(cfg, "episodes.randomize", default=None)) or {}, "")
+    return dict(sorted(found.items()))
 
 
 def describe(dist: Mapping) -> str:
@@ -70,7 +91,8 @@ def check_distribution(key: str, dist: Any, default: Any) -> None:
     unknown = set(dist) - {*DISTRIBUTIONS, "clip", "add", "scale"}
     if len(kinds) != 1 or unknown:
         raise BadDistribution(f"episodes.randomize.{key} needs exactly one of {', '.join(DISTRIBUTIONS)} "
-                              f"(and optionally clip, add, scale); got {sorted(dist)}")
+                              f"(and optionally clip, add, scale); got {sorted(dist)} (to replace one: "
+                              f"~episodes.randomize.{key} +episodes.randomize.{key}=...)")
     kind = kinds[0]
     args = dist[kind]
     if kind == "choice":
