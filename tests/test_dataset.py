@@ -136,8 +136,8 @@ def test_bad_exports_are_refused_in_one_line(data_dir):
     assert not (data_dir / "datasets").exists()
 
 
-def test_runs_of_different_robots_make_one_dataset_each(tmp_path):
-    """A sweep over chain lengths cannot share one LeRobot feature shape: one dataset per shape."""
+def _two_robots(tmp_path):
+    """Runs of a one-link and a two-link chain, exported: one dataset per shape."""
     from pipeline.dataset import Source, export
 
     runs = tmp_path / "runs"
@@ -153,6 +153,26 @@ def test_runs_of_different_robots_make_one_dataset_each(tmp_path):
             w.close("ok")
     written = export([Source(runs)], tmp_path / "out", fps=10)
     assert sorted(p.name for p in written) == ["state2-action1", "state4-action2"]
+    return written
+
+
+def test_runs_of_different_robots_make_one_dataset_each(tmp_path):
+    """A sweep over chain lengths cannot share one LeRobot feature shape: one dataset per shape."""
+    _two_robots(tmp_path)
     frames, episodes = _load(tmp_path / "out/state2-action1")
     assert episodes["run_id"] == ["r0", "r1"] and frames.num_rows == 22
     assert np.allclose(frames["observation.state"][10], [1.0, 1.0])   # q0 = t, its velocity 1 at t = 1 s
+
+
+def test_the_official_lerobot_class_loads_the_export(tmp_path):
+    """Runs where `lerobot` is installed (it pins torch and an older rerun-sdk: `make lerobot-check` builds
+    its own virtual environment)."""
+    lerobot = pytest.importorskip("lerobot.datasets.lerobot_dataset")
+    _two_robots(tmp_path)
+    root = tmp_path / "out/state2-action1"
+    dataset = lerobot.LeRobotDataset("local/demo", root=root)
+    info = json.loads((root / "meta/info.json").read_text())
+    assert len(dataset) == info["total_frames"] == 22 and dataset.num_episodes == 2 and dataset.fps == 10
+    frame = dataset[12]   # the second episode's second frame
+    assert int(frame["episode_index"]) == 1 and int(frame["frame_index"]) == 1
+    assert np.allclose(frame["observation.state"].numpy(), [0.1, 1.0], atol=1e-6)

@@ -170,14 +170,14 @@ def _frame(times: np.ndarray, rows: dict[str, Any]) -> pd.DataFrame:
     return pd.DataFrame(rows, index=index).sort_index(kind="stable")
 
 
-def _read_topic(f, summary, channel_id: int, decode) -> pd.DataFrame | None:
+def _read_topic(f, summary, channel_id: int, decode, arrays: bool = True) -> pd.DataFrame | None:
     chunks = list(_chunks(f, summary, channel_id))
     starts = [_walk(data, channel_id, first_only=True) for data in chunks]
     payload = next((found[0][1] for _, found in starts if found), None)
     if payload is None:
         return None
     first = decode(payload)
-    layout = _Layout(type(first), first, payload) if isinstance(first, Message) else None
+    layout = _Layout(type(first), first, payload) if arrays and isinstance(first, Message) else None
     if layout is not None and layout.ok:
         blocks, reference = [], None
         for data, (start, _) in zip(chunks, starts, strict=True):
@@ -233,8 +233,9 @@ class _Ros2StringDecoder:
         return None
 
 
-def read_topics(path: str | Path, topics: Iterable[str]) -> dict[str, pd.DataFrame]:
-    """Topic -> DataFrame indexed by simulated time `t` (s), for each of `topics` the file has."""
+def read_topics(path: str | Path, topics: Iterable[str], arrays: bool = True) -> dict[str, pd.DataFrame]:
+    """Topic -> DataFrame indexed by simulated time `t` (s), for each of `topics` the file has. `arrays=False`
+    decodes every message with protobuf (the general path; the benchmark compares the two)."""
     wanted = set(topics)
     frames: dict[str, pd.DataFrame] = {}
     factories = (DecoderFactory(), _Ros2StringDecoder())
@@ -247,7 +248,7 @@ def read_topics(path: str | Path, topics: Iterable[str]) -> dict[str, pd.DataFra
                 continue
             schema = summary.schemas[channel.schema_id]
             decode = next(d for d in (f.decoder_for(channel.message_encoding, schema) for f in factories) if d)
-            frame = _read_topic(f, summary, channel_id, decode)
+            frame = _read_topic(f, summary, channel_id, decode, arrays)
             if frame is not None:
                 frames[channel.topic] = frame
     return frames

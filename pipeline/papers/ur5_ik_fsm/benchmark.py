@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from pipeline.core.checks import compose_config
-from pipeline.core.runlog import RunWriter
+from pipeline.core.runlog import RunWriter, read_run, run_files
 from pipeline.core.timing import best_of, time_calls
 from pipeline.papers.ur5_ik_fsm import experiments as ex
 from pipeline.papers.ur5_ik_fsm import ik
@@ -113,6 +113,26 @@ def benchmark() -> list[dict]:
     return rows
 
 
+def reader(rows: list[dict], paths: list[Path]) -> None:
+    """Reading every topic of `paths` back: series of one fixed layout as NumPy arrays (the reader's default)
+    against decoding each message with protobuf; messages per second, both in this one process."""
+    import time
+
+    from pipeline.core.decoding import read_topics
+
+    topics = read_run(paths[0]).topic_names
+    messages = sum(read_run(p).message_count(t) for p in paths for t in topics)
+    for arrays, measure in ((False, "message by message (protobuf)"), (True, "fixed-layout series as arrays")):
+        seconds = []
+        for _ in range(3):
+            start = time.perf_counter()
+            for p in paths:
+                read_topics(p, topics, arrays=arrays)
+            seconds.append(time.perf_counter() - start)
+        rows.append({"what": f"reader: every topic of {len(paths)} random-paths runs ({messages} messages)",
+                     "measure": measure, "value": messages / float(np.median(seconds)), "unit": "messages/s"})
+
+
 def dataset(rows: list[dict], episodes: int = 1000) -> None:
     """The dataset generator end to end, as a user runs it: `episodes` randomized paths (random-paths) simulated
     and logged in one process over the cores, then exported as a LeRobot dataset; and where one episode's time
@@ -140,6 +160,7 @@ def dataset(rows: list[dict], episodes: int = 1000) -> None:
                        check=True, capture_output=True)
         total = time.perf_counter() - start
         size = sum(p.stat().st_size for p in (Path(tmp) / "datasets").rglob("*") if p.is_file())
+        reader(rows, run_files(Path(tmp) / "runs/ur5-ik-fsm/random-paths")[:40])
     workers = parallel.workers_for(0, episodes)
     rows += [
         {"what": what, "measure": f"simulate + log ({workers} workers, one process start)", "value": simulated,
