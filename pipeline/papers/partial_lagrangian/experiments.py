@@ -140,7 +140,7 @@ def random_states(rng: np.random.Generator, n: int, count: int) -> tuple[np.ndar
 LinkTermsRow = schemas.define(
     "PartialLagrangianTerms", "Terms of link i's expanded symbolic partial Lagrangian L_i and of its derivatives "
     "(k = 1..i): ∂L_i/∂θ_k, ∂L_i/∂θ̇_k, τ_ki = D_k L_i; and the wall time of counting them (s).",
-    link="int64", lagrangian="int64", d_angle="int64[]", d_rate="int64[]", tau="int64[]", seconds="double",
+    link="int64 1", lagrangian="int64 1", d_angle="int64[] 1", d_rate="int64[] 1", tau="int64[] 1", seconds="double s",
 )
 
 

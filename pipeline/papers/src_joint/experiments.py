@@ -304,8 +304,8 @@ FloorRow = schemas.define(
     "SrcReachFloor", "The closest a 3-joint equal-sphere chain comes to a target pose: one joint-update mode, one "
     "reading of the target quaternion, one weighting of orientation against position (m per rad), and the most the "
     "closed-form kinematics differs from the paper's model (every model form) at that configuration (m).",
-    mode="string", reading="string", weight_m_per_rad="double", position_error_m="double",
-    orientation_error_rad="double", model_difference_m="double",
+    mode="string", reading="string", weight_m_per_rad="double m/rad", position_error_m="double m",
+    orientation_error_rad="double rad", model_difference_m="double m",
 )
 
 
@@ -354,7 +354,7 @@ def reach_floor(cfg: DictConfig) -> list[Case]:
                               ik, k.dt, k.duration, k.tol_position, k.tol_orientation, k.stall_time, k.stall_change)
             rows += [np.linalg.norm(result.position_error[-1]), np.linalg.norm(result.orientation_error[-1]),
                      float(result.converged), np.abs(result.chain.joint_quaternions()[:, 3]).max()]
-        log.log("/reach/ik", 0.0, schemas.Scalars,
+        log.log("/reach/ik", 0.0, schemas.Scalars, units=["m", "rad", "1", "1"] * len(f.modes),
                 name=[f"{m}.{x}" for m in f.modes for x in ("position_error", "orientation_error", "converged",
                                                            "eps_z_max")], value=rows)
         if best is not None:   # the closest exact-rolling pose, to look at beside the target
@@ -364,7 +364,8 @@ def reach_floor(cfg: DictConfig) -> list[Case]:
             log.log_transforms(np.zeros(1), "world", [*bodies, "target"],
                                np.concatenate([poses(pos, rot), target_pose[None, None]], axis=1))
             log_spheres(log, bodies, [radius] * (n + 1), [BASE_COLOR] + [LINK_COLOR] * n)
-            log.log("/joint_state", 0.0, name=joint_names(n, AXES), position=best.rotvecs.ravel().tolist())
+            log.log("/joint_state", 0.0, units="rad", name=joint_names(n, AXES),
+                    position=best.rotvecs.ravel().tolist())
 
     def simulate_loop(log: RunWriter) -> None:
         """One joint rolled round a closed square of Ω^B (+x, +y, −x, −y): the model in both joint-update
@@ -383,12 +384,12 @@ def reach_floor(cfg: DictConfig) -> list[Case]:
                 plant.roll(sides[j:j + 1], dt)
         quaternions *= np.where(quaternions[..., :1] < 0, -1.0, 1.0)
         t = np.arange(len(sides) + 1) * dt
-        log.log_series("/joint_state", t, name=[f"{m}.{a}" for m in (*reach.MODES, "plant") for a in AXES],
+        log.log_series("/joint_state", t, units="rad", name=[f"{m}.{a}" for m in (*reach.MODES, "plant") for a in AXES],
                        position=qlog(quaternions).reshape(len(t), -1))
-        log.log_series("/eq5/joint_quaternion", t, schemas.Scalars,
+        log.log_series("/eq5/joint_quaternion", t, schemas.Scalars, units="1",
                        name=[f"{m}.{c}" for m in (*reach.MODES, "plant") for c in ("qw", "qx", "qy", "qz")],
                        value=quaternions.reshape(len(t), -1))
-        log.log_series("/reference", t[:-1], name=["x", "y"], velocity=sides)
+        log.log_series("/reference", t[:-1], units="rad", name=["x", "y"], velocity=sides)   # Ω^B, rad/s
 
     cases = [Case(name, lambda log, x=name: simulate_target(log, x)) for name in sc.targets]
     return [*cases, Case("eq5-loop", simulate_loop)]
