@@ -189,7 +189,7 @@ def dataset(rows: list[dict], episodes: int = 1000) -> None:
             t2 = time.perf_counter()
             times, q_ref, qd_ref = ex.servo_references(q_ik, ik_times, episode_cfg.execute.dt, True,
                                                        episode_cfg.system.dynamics.velocity_limit)
-            ex.run_servo(ex.arm_model(episode_cfg, ex.geometry(episode_cfg), q_ref[0]), q_ref, qd_ref, times)
+            servo_rollout(ex.arm_model(episode_cfg, ex.geometry(episode_cfg), q_ref[0]), q_ref, qd_ref, times)
             t3 = time.perf_counter()
             _run_case(case, f"e{index}", Path(tmp), config_yaml, {"run_id": f"e{index}"})
             t4 = time.perf_counter()
