@@ -176,3 +176,12 @@ def test_the_official_lerobot_class_loads_the_export(tmp_path):
     frame = dataset[12]   # the second episode's second frame
     assert int(frame["episode_index"]) == 1 and int(frame["frame_index"]) == 1
     assert np.allclose(frame["observation.state"].numpy(), [0.1, 1.0], atol=1e-6)
+
+
+def test_every_export_stage_exports_an_experiment_of_the_pipeline():
+    from .conftest import ROOT
+
+    variables = {k: v for block in yaml.safe_load((ROOT / "dvc.yaml").read_text())["vars"] for k, v in block.items()}
+    assert variables["datasets"] and set(variables["datasets"]) <= set(variables["experiments"])
+    for key, item in variables["datasets"].items():
+        assert key == f"{item['slug']}-{item['name']}" and item["module"] == item["slug"].replace("-", "_")
