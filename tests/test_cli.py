@@ -72,7 +72,7 @@ def test_sweep_runs_one_file_per_point_in_parallel(data_dir):
     assert proc.returncode == 0, proc.stderr
     assert "LokyBackend with 2 concurrent workers" in proc.stderr  # joblib: parallel processes
     runs = [read_run(p) for p in run_files(data_dir / "runs/ur5-ik-fsm/singular-paths")]
-    assert sorted(r.params["execute.bandwidth_hz"] for r in runs) == ["10", "6"]
+    assert sorted(r.params["execute.bandwidth_hz"] for r in runs) == [6, 10]   # typed: numbers as numbers
     assert all(r.ok for r in runs) and len({r.run_id for r in runs}) == 2
 
 
@@ -84,7 +84,7 @@ def test_a_sweep_on_two_local_ray_workers(data_dir):
     assert proc.returncode == 0, proc.stderr
     assert "is validated against ConfigStore schema" not in proc.stderr  # no deprecation noise from our config
     runs = [read_run(p) for p in run_files(data_dir / "runs/ur5-ik-fsm/singular-paths")]
-    assert sorted(r.params["execute.bandwidth_hz"] for r in runs) == ["10", "6"] and all(r.ok for r in runs)
+    assert sorted(r.params["execute.bandwidth_hz"] for r in runs) == [6, 10] and all(r.ok for r in runs)
 
 
 def test_divergence_is_a_failed_run_and_the_stage_goes_on(data_dir):
