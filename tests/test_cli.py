@@ -74,7 +74,7 @@ def test_sweep_runs_one_file_per_point_in_parallel(data_dir):
     (sweep,) = (data_dir / "sweeps").iterdir()                       # its own folder, named by its start time
     assert not (data_dir / "runs").exists()
     runs = [read_run(p) for p in run_files(sweep / "runs/ur5-ik-fsm/singular-paths")]
-    assert sorted(r.params["execute.bandwidth_hz"] for r in runs) == ["10", "6"]
+    assert sorted(r.params["execute.bandwidth_hz"] for r in runs) == [6, 10]
     assert all(r.ok for r in runs) and len({r.run_id for r in runs}) == 2
 
 
@@ -86,7 +86,7 @@ def test_a_sweep_on_two_local_ray_workers(data_dir):
     assert proc.returncode == 0, proc.stderr
     assert "is validated against ConfigStore schema" not in proc.stderr  # no deprecation noise from our config
     runs = [read_run(p) for p in run_files(data_dir / "sweeps/ray/runs/ur5-ik-fsm/singular-paths")]
-    assert sorted(r.params["execute.bandwidth_hz"] for r in runs) == ["10", "6"] and all(r.ok for r in runs)
+    assert sorted(r.params["execute.bandwidth_hz"] for r in runs) == [6, 10] and all(r.ok for r in runs)
 
 
 def test_divergence_is_a_failed_run_and_the_stage_goes_on(data_dir):

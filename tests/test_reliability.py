@@ -221,7 +221,7 @@ def test_an_interrupt_swallowed_by_a_simulator_is_still_an_interrupt(tmp_path):
         from pipeline.core.runlog import SimulationFailed
 
         def swallowing(log):
-            log.log("/joint_state", 0.0, name=["a"], position=[0.0])
+            log.log("/joint_state", 0.0, units="rad", name=["a"], position=[0.0])
             try:
                 os.kill(os.getpid(), signal.SIGINT)
             except KeyboardInterrupt:
@@ -307,7 +307,7 @@ def test_a_non_finite_state_fails_the_run_at_its_time(tmp_path):
         q = np.zeros((5, 2))
         q[3, 1] = np.nan
         with pytest.raises(SimulationFailed, match=r"non-finite /joint_state position at t = 0.3 s"):
-            w.log_series("/joint_state", np.arange(5) * 0.1, name=["a", "b"], position=q)
+            w.log_series("/joint_state", np.arange(5) * 0.1, units="rad", name=["a", "b"], position=q)
         with pytest.raises(SimulationFailed, match="non-finite /wrench"):
             w.log("/wrench/contact", 1.0, frame_id="world", name=["c"], force_x=[np.inf])
 

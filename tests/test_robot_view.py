@@ -113,7 +113,7 @@ def write_run(path, n: int = 400):
     t = np.arange(n) * 1e-3
     with RunWriter(path, {"run_id": path.stem, "slug": "demo"}) as w:
         w.attach("model.xml", MODEL, "application/xml")
-        w.log_series("/tracking_error", t, name=["x"], error=qpos[:, :1], norm=np.abs(qpos[:, 0]))
+        w.log_series("/tracking_error", t, units="m", name=["x"], error=qpos[:, :1], norm=np.abs(qpos[:, 0]))
         w.log_robot(t, qpos, mocap_pos, mocap_quat)
         w.close("ok")
     return t
@@ -138,7 +138,8 @@ def test_joint_state_names_draw_the_robot_unasked(tmp_path):
       <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.02"/></body></worldbody></mujoco>"""
     with RunWriter(tmp_path / "r.mcap", {"run_id": "r"}) as w:
         w.attach("model.xml", xml, "application/xml")
-        w.log_series("/joint_state", np.arange(3) * 0.1, name=["j1"], position=np.array([[0.0], [0.1], [0.2]]))
+        w.log_series("/joint_state", np.arange(3) * 0.1, units="rad", name=["j1"],
+                     position=np.array([[0.0], [0.1], [0.2]]))
         w.close("ok")
     states = read_run(tmp_path / "r.mcap")["/joint_states"]
     assert np.allclose(states["joints.j1.position"], [0.0, 0.1, 0.2])

@@ -11,12 +11,14 @@ import sys
 import textwrap
 
 import numpy as np
+import pandas as pd
 import pytest
 from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
 from mcap.reader import make_reader
 
 from pipeline.core import schemas
-from pipeline.core.runlog import RunWriter, read_run, run_files
+from pipeline.core.decoding import read_topics
+from pipeline.core.runlog import RunWriter, read_run, read_runs, run_files, typed
 
 from .conftest import ENV, ROOT
 
@@ -28,7 +30,7 @@ def write_sample(path):
     with RunWriter(path, {"slug": "demo", "experiment": "e", "run_id": path.stem, "case": "c", "seed": "0",
                           "params": {"a.b": "1"}}) as w:
         w.attach("config.yaml", "x: 1\n", "application/yaml")
-        w.log_series("/joint_state", t, name=NAMES, position=np.arange(15.0).reshape(5, 3),
+        w.log_series("/joint_state", t, units=["rad", "rad", "m"], name=NAMES, position=np.arange(15.0).reshape(5, 3),
                      velocity=np.ones((5, 3)), effort=np.zeros((5, 3)))
         w.log("/wrench", 0.002, frame_id="tool", name=["c"], force_x=[1.0], force_y=[2.0], force_z=[3.0],
               torque_x=[0.0], torque_y=[0.0], torque_z=[0.5])
@@ -43,7 +45,7 @@ def write_sample(path):
 def test_round_trip(tmp_path):
     t = write_sample(tmp_path / "r.mcap")
     run = read_run(tmp_path / "r.mcap")
-    assert run.ok and run.run_id == "r" and run.params == {"a.b": "1"}
+    assert run.ok and run.run_id == "r" and run.params == {"a.b": 1}   # typed, as Hydra reads the override
     assert run.attachments["config.yaml"] == b"x: 1\n"
     js = run["/joint_state"]
     assert np.allclose(js.index, t) and js.index.name == "t"
@@ -83,7 +85,7 @@ def test_unfinished_run_is_never_listed(tmp_path):
         import numpy as np
         from pipeline.core.runlog import RunWriter
         w = RunWriter({str(tmp_path / "killed.mcap")!r}, {{"run_id": "killed"}})
-        w.log_series("/joint_state", np.arange(1000) * 1e-3, name=["a"], position=np.zeros((1000, 1)))
+        w.log_series("/joint_state", np.arange(1000) * 1e-3, units="rad", name=["a"], position=np.zeros((1000, 1)))
         os.kill(os.getpid(), signal.SIGKILL)
     """)
     proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=ENV)
@@ -97,7 +99,7 @@ def test_interrupt_keeps_the_previous_complete_run(tmp_path):
     write_sample(tmp_path / "r.mcap")
     before = (tmp_path / "r.mcap").read_bytes()
     with pytest.raises(KeyboardInterrupt), RunWriter(tmp_path / "r.mcap", {"run_id": "r"}) as w:
-        w.log("/joint_state", 0.0, name=["a"], position=[1.0])
+        w.log("/joint_state", 0.0, units="rad", name=["a"], position=[1.0])
         raise KeyboardInterrupt
     assert (tmp_path / "r.mcap").read_bytes() == before
     assert [p.name for p in tmp_path.iterdir()] == ["r.mcap"]
@@ -118,3 +120,72 @@ def test_rerun_reads_the_run(tmp_path):
 def test_no_partial_left_after_normal_close(tmp_path):
     write_sample(tmp_path / "r.mcap")
     assert os.listdir(tmp_path) == ["r.mcap"]
+
+
+def test_every_column_has_its_unit(tmp_path):
+    write_sample(tmp_path / "r.mcap")
+    run = read_run(tmp_path / "r.mcap")
+    joints = run.units("/joint_state")
+    assert joints["position.j1"] == "rad" and joints["velocity.j1"] == "rad/s" and joints["effort.j1"] == "N*m"
+    assert joints["position.j3"] == "m" and joints["velocity.j3"] == "m/s" and joints["effort.j3"] == "N"
+    assert set(joints) == set(run["/joint_state"].columns)
+    assert run["/joint_state"].attrs["units"] == joints
+    assert run.units("/wrench")["force_x.c"] == "N" and run.units("/wrench")["torque_z.c"] == "N*m"
+    assert run.units("/compute_time") == {"seconds.solver": "s", "calls.solver": "1"}
+    assert run.units("/tf")["transforms.tool.translation.x"] == "m"
+
+
+def test_a_number_without_a_unit_is_refused(tmp_path):
+    with RunWriter(tmp_path / "x.mcap", {}) as w:
+        with pytest.raises(ValueError, match=r"unit of position.a is not known: pass units="):
+            w.log("/joint_state", 0.0, name=["a"], position=[1.0])
+        with pytest.raises(ValueError, match=r"unit of norm is not known: pass field_units"):
+            w.log("/tracking_error", 0.0, units=["m", "rad"], name=["x", "r"], error=[1.0, 0.1], norm=1.0)
+        with pytest.raises(ValueError, match="gives 1 units for 2 entries"):
+            w.log("/reference", 0.0, units=["m"], name=["x", "y"], position=[1.0, 2.0])
+        w.log("/command", 0.0, units="m", kind="force", name=["x"], value=[1.0])
+        with pytest.raises(ValueError, match="was logged in N, now in N\\*m"):
+            w.log("/command", 0.1, units="rad", kind="torque", name=["x"], value=[1.0])
+    with pytest.raises(ValueError, match="field x needs a unit"):
+        schemas.define("NoUnit", "a field without its unit", x="double")
+
+
+def test_the_fast_reader_equals_protobuf_decoding(tmp_path):
+    """Series of doubles are read as one NumPy view; messages whose layout changes (a string that varies, a
+    field that comes and goes, a zero scalar protobuf leaves out) fall back to message-by-message decoding."""
+    n = 50
+    t = np.arange(n) * 0.01
+    with RunWriter(tmp_path / "m.mcap", {"run_id": "m"}) as w:
+        w.log_series("/joint_state", t, units="rad", name=NAMES, position=np.random.default_rng(0).normal(size=(n, 3)),
+                     velocity=np.ones((n, 3)))
+        w.log_series("/tracking_error", t, units="m", name=["x"], error=np.zeros((n, 1)), norm=np.zeros(n))
+        w.log_series("/command", t, units="rad", kind="torque", name=NAMES, value=np.ones((n, 3)))
+        for k in range(n):  # per-record calls: the norm is 0 (left out by protobuf) in some records only
+            w.log("/tracking_error/flange", float(t[k]), units="m", name=["x"], error=[k % 3], norm=float(k % 3))
+            w.log("/probe", float(t[k]), schemas.Scalars, units="1", name=["a", "b"][: 1 + k % 2],
+                  value=[1.0, 2.0][: 1 + k % 2])
+        w.close("ok")
+    topics = ["/joint_state", "/tracking_error", "/command", "/tracking_error/flange", "/probe"]
+    fast = read_topics(tmp_path / "m.mcap", topics)
+    slow = read_topics(tmp_path / "m.mcap", topics, arrays=False)
+    for topic in topics:
+        pd.testing.assert_frame_equal(fast[topic], slow[topic], check_dtype=False)
+    assert list(fast["/command"].columns) == ["kind", "value.j1", "value.j2", "value.j3"]
+    assert fast["/probe"]["value.b"].isna().sum() == n // 2
+
+
+def test_typed_values_and_a_sweep_in_one_frame(tmp_path):
+    assert typed("4") == 4 and typed("0.5") == 0.5 and typed("1e-4") == 1e-4 and typed("true") is True
+    assert typed("[wrist,1]") == ["wrist", 1] and typed("null") is None and typed("alg2") == "alg2"
+    for k, gain in enumerate((2.0, 8.0)):
+        with RunWriter(tmp_path / f"r{k}.mcap", {"run_id": f"r{k}", "params": {"execute.gain": str(gain)},
+                                                 "values": {"execute.gain": gain}}) as w:
+            w.log_series("/tracking_error", np.arange(3) * 0.1, units="rad", name=["a"], error=np.full((3, 1), gain),
+                         norm=np.full(3, gain))
+            w.close("ok")
+    frame = read_runs(tmp_path, "/tracking_error")
+    assert list(frame.columns[:3]) == ["t", "run_id", "execute.gain"] and len(frame) == 6
+    assert frame["execute.gain"].dtype.kind == "f" and (frame["error.a"] == frame["execute.gain"]).all()
+    assert frame.attrs["units"]["norm"] == "rad"
+    table = read_runs(tmp_path).table()
+    assert table["execute.gain"].tolist() == [2.0, 8.0]

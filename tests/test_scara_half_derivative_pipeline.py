@@ -35,7 +35,7 @@ def test_setpoint_and_a_maps_sweep_to_report(data_dir):
 
     runs = read_runs(data_dir / "runs" / SLUG / "maps")
     assert len(runs) == 8 and all(r.ok for r in runs)
-    assert {r.params["scenario.k_xyz"] for r in runs} == {"80000", "10000"}
+    assert {r.params["scenario.k_xyz"] for r in runs} == {80000, 10000}
     run = runs[0]
     assert {"/joint_state", "/reference", "/command", "/tracking_error", "/tf"} <= set(run.topic_names)
     assert "model.yaml" in run.attachments and "config.yaml" in run.attachments

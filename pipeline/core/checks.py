@@ -93,6 +93,8 @@ def _of(kind: type, limits: tuple[Limit, ...]) -> Any:
 
 def _check_shape(value: Any, default: Any, key: str, limits: dict) -> None:
     """A list stays a list (of its default's length, unless declared `Length`), a single value single."""
+    if key == "episodes.randomize":
+        return   # distributions, each checked against the key it draws (check_episodes)
     if isinstance(default, DictConfig):
         for k in default:
             if k in value and not (not key and k == "hydra"):
@@ -199,6 +201,105 @@ def check_cases(cfg: DictConfig, experiment: Experiment) -> list[Case]:
     return cases
 
 
+def check_episodes(cfg: DictConfig, experiment: Experiment) -> None:
+    """Randomized episodes: every distribution well formed and on a real key; every episode's drawn values in
+    their ranges and choices, its rules holding, and one run each; the budget summed over the episodes."""
+    from pipeline.core import episodes
+
+    count = int(OmegaConf.select(cfg, "episodes.count", default=0) or 0)
+    specs = episodes.randomized(cfg)
+    if not count:
+        return
+    known = [k for k, _ in _leaves(cfg) if not k.startswith(("hydra", "episodes"))]
+    for key, dist in specs.items():
+        plain = re.sub(r"\[\d+\]", "", key)
+        if key not in known and not any(k.startswith(plain + "[") for k in known):
+            hint = difflib.get_close_matches(key, known, n=1)
+            raise BadInput(f"episodes.randomize.{key}: no such config key" + (f" (did you mean '{hint[0]}'?)"
+                                                                             if hint else ""))
+        try:
+            episodes.check_distribution(key, dist, _select(cfg, key))
+        except episodes.BadDistribution as err:
+            raise BadInput(str(err)) from None
+    base = OmegaConf.to_container(cfg, resolve=True)
+    defaults = {key: _select(cfg, key) for key in specs}
+    total = 0.0
+    budget = experiment.budget
+    for index in range(count):   # plain dicts: 100,000 episodes are checked in seconds
+        values = episodes.draw(cfg, index)
+        work = episodes.apply(base, values, 0) if index < 16 or index == count - 1 else _set(base, values)
+        for key, value in values.items():
+            try:
+                _check_values(key, value, defaults[key], experiment)
+            except BadInput as err:
+                raise BadInput(f"episode {index}: {err}") from None
+        for rule in experiment.rules:
+            found = [_lookup(work, k) for k in rule.keys]
+            if all(v is not None for v in found) and not rule.holds(*found):
+                raise BadInput(f"episode {index}: {rule.message.format(*found)}")
+        if index < 16 or index == count - 1:   # the number of runs depends on lists, not on drawn numbers
+            made = experiment.fn(OmegaConf.create(work))
+            if len(made) != 1:
+                raise BadInput(f"{experiment.id}: episode {index} would make {len(made)} runs ("
+                               f"{', '.join(c.id for c in made[:3])}, ...): an episode is one run; fix or "
+                               "randomize the lists that multiply it")
+        total += budget.estimate(_Attributes(work)) if budget is not None else 0.0
+        if budget is not None and not total <= budget.limit:   # said as soon as it is known
+            total *= count / (index + 1)
+            raise BadInput(f"{experiment.id}: {count} episodes would need about {total:.3g} {budget.what}, more "
+                           f"than the budget of {budget.limit:.3g}: fewer episodes"
+                           + (f", {budget.hint}" if budget.hint else ""))
+
+
+class _Attributes(dict):
+    """A plain config read like a DictConfig (`c.scenario.duration`), for cost estimates."""
+
+    def __getattr__(self, name: str) -> Any:
+        try:
+            value = self[name]
+        except KeyError:
+            raise AttributeError(name) from None
+        return _Attributes(value) if isinstance(value, dict) else value
+
+
+def _lookup(plain: dict, key: str) -> Any:
+    node: Any = plain
+    for part in key.split("."):
+        if not isinstance(node, dict) or part not in node:
+            return None
+        node = node[part]
+    return node
+
+
+def _set(plain: dict, values: dict) -> dict:
+    """Write an episode's values into `plain` in place (every episode sets the same keys)."""
+    for key, value in values.items():
+        *parents, last = key.split(".")
+        node = plain
+        for part in parents:
+            node = node[part]
+        node[last] = value
+    return plain
+
+
+def _check_values(key: str, value: Any, default: Any, experiment: Experiment) -> None:
+    """One drawn value against its key's declared shape, range and choices."""
+    allowed = declared(experiment.limits, key)
+    elements = value if isinstance(value, list) else [value]
+    if isinstance(default, list) != isinstance(value, list):
+        raise BadInput(f"{key}={_short(value)} must be {'a list' if isinstance(default, list) else 'one value'} "
+                       f"like its default {_short(default)}")
+    length = _of(Length, allowed)
+    if isinstance(value, list) and (len(value) not in length if length else len(value) != len(default)):
+        raise BadInput(f"{key} has {len(value)} elements: must be {length or len(default)}")
+    choice, interval = _of(OneOf, allowed), _of(Range, allowed)
+    for x in elements:
+        if choice is not None and x not in choice:
+            raise BadInput(f"{key}={_short(x)} is not allowed: must be {choice}")
+        if _is_number(x) and (not math.isfinite(x) or (interval is not None and x not in interval)):
+            raise BadInput(f"{key}={x:g} is out of range: must be {interval}")
+
+
 def check_data_dir(value: Any) -> Path:
     """Where every output goes: a directory this process can create or write."""
     if value is None or not str(value).strip():
@@ -248,6 +349,9 @@ def _one_line(err: Exception, overrides: list[str], valid_keys: list[str]) -> st
     text = str(err)
     if "not in struct" in str(root) or "Could not override" in text or "Could not append" in text:
         key = text.split("'")[1] if "'" in text else str(root)
+        if key.startswith("episodes.randomize."):   # struct mode: a distribution is replaced, not merged
+            return (f"{key}: to replace a distribution, remove it and add the new one: ~{key} "
+                    f"'+{key}={{uniform:[a,b]}}'")
         hint = difflib.get_close_matches(key, valid_keys, n=1)
         return f"unknown config key '{key}'" + (f" (did you mean '{hint[0]}'?)" if hint else "")
     if "Could not find" in text or "Could not load" in text:
@@ -292,8 +396,9 @@ def preflight(argv: list[str]) -> None:
                     importlib.util.find_spec(plugin) is None:
                 raise BadInput(f"hydra/launcher={launcher} needs its extra: pip install -e '.[{extra_name}]'")
         for o in extra:
-            if o.startswith("+") and not o.startswith("+hydra"):
-                raise BadInput(f"adding keys is not allowed ('{o}'): every parameter has a default in conf/")
+            if o.startswith("+") and not o.startswith(("+hydra", "+episodes.randomize.")):
+                raise BadInput(f"adding keys is not allowed ('{o}'): every parameter has a default in conf/ "
+                               "(only distributions are added: +episodes.randomize.<key>={uniform:[a,b]})")
         if experiment_id not in checked:
             defaults = compose_config([f"experiment={experiment_id}"])
             checked[experiment_id] = (defaults, [k for k, _ in _leaves(defaults)], resolve(experiment_id))
@@ -307,4 +412,5 @@ def preflight(argv: list[str]) -> None:
         check_config(cfg, defaults, experiment.limits)
         check_rules(cfg, experiment)
         check_cases(cfg, experiment)
+        check_episodes(cfg, experiment)
     GlobalHydra.instance().clear()

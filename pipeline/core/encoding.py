@@ -1,4 +1,4 @@
-"""Encode a whole series of protobuf messages at once.
+"""Encode a whole series of protobuf messages at once (and, in pipeline.core.decoding, read it back the same way).
 
 Messages whose per-sample fields are all `double` (scalar or repeated) and whose other fields are the
 same in every sample have a fixed byte layout: the constant fields, then each double field's key (and
@@ -32,10 +32,10 @@ def _repeated(fd: FieldDescriptor) -> bool:
     return fd.is_repeated if hasattr(fd, "is_repeated") else fd.label == FieldDescriptor.LABEL_REPEATED
 
 
-def encode_series(cls: type[Message], constant: dict[str, Any],
-                  per_sample: dict[str, np.ndarray]) -> list[bytes] | None:
-    """Serialized messages, one per row of the `per_sample` arrays; None if the fast layout does not apply
-    (a per-sample field that is not a double), so the caller falls back to protobuf."""
+def series_layout(cls: type[Message], constant: dict[str, Any],
+                  per_sample: dict[str, np.ndarray]) -> tuple[np.dtype, dict[str, bytes | np.ndarray]] | None:
+    """The structured dtype of one serialized message and what fills it (constant bytes, per-sample arrays);
+    None if a per-sample field is not a double."""
     n = len(next(iter(per_sample.values()))) if per_sample else 0
     dtype: list[tuple] = []
     fill: dict[str, bytes | np.ndarray] = {}
@@ -61,7 +61,19 @@ def encode_series(cls: type[Message], constant: dict[str, Any],
     unknown = (set(constant) | set(per_sample)) - set(cls.DESCRIPTOR.fields_by_name)
     if unknown:
         raise ValueError(f"{cls.DESCRIPTOR.full_name} has no field(s) {sorted(unknown)}")
-    records = np.empty(n, dtype=np.dtype(dtype))
+    return np.dtype(dtype), fill
+
+
+def encode_series(cls: type[Message], constant: dict[str, Any],
+                  per_sample: dict[str, np.ndarray]) -> list[bytes] | None:
+    """Serialized messages, one per row of the `per_sample` arrays; None if the fast layout does not apply
+    (a per-sample field that is not a double), so the caller falls back to protobuf."""
+    layout = series_layout(cls, constant, per_sample)
+    if layout is None:
+        return None
+    dtype, fill = layout
+    n = len(next(iter(per_sample.values()))) if per_sample else 0
+    records = np.empty(n, dtype=dtype)
     for key, value in fill.items():
         records[key] = np.void(value) if isinstance(value, bytes) else value
     buffer = records.tobytes()

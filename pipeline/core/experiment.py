@@ -156,6 +156,11 @@ NAMED_LIMITS: dict[str, Range] = {
     "log_dt": Range(ge=1e-4, le=10), "tf_dt": Range(ge=1e-4, le=10), "workers": Range(ge=0, le=64),
 }
 MAX_CASES = 1000  # runs one experiment may make in one process
+# The root config's own keys (conf/config.yaml), declared for every experiment
+ROOT_LIMITS: dict[str, Limit | tuple[Limit, ...]] = {
+    "episodes.count": Range(ge=0, le=100_000),
+    "episodes.randomize": Text(),   # distributions: checked episode by episode (pipeline.core.checks)
+}
 
 
 def module_name(slug: str) -> str:
@@ -196,5 +201,6 @@ def resolve(experiment_id: str) -> Experiment:
         fn = module.EXPERIMENTS[name]
     except KeyError:
         raise KeyError(f"pipeline.papers.{module_name(slug)} has no experiment '{name}'") from None
-    return Experiment(slug, name, fn, getattr(module, "LIMITS", {}), tuple(getattr(module, "RULES", ())),
-                      getattr(module, "BUDGETS", {}).get(name), name in getattr(module, "TIMED", ()))
+    return Experiment(slug, name, fn, {**ROOT_LIMITS, **getattr(module, "LIMITS", {})},
+                      tuple(getattr(module, "RULES", ())), getattr(module, "BUDGETS", {}).get(name),
+                      name in getattr(module, "TIMED", ()))

@@ -8,7 +8,6 @@ file atomically.
 
 from __future__ import annotations
 
-import functools
 import json
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
@@ -19,14 +18,14 @@ import numpy as np
 import yaml
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 from google.protobuf import descriptor_pb2
-from google.protobuf.descriptor import Descriptor, FieldDescriptor
+from google.protobuf.descriptor import Descriptor
 from google.protobuf.message import Message
 from mcap.reader import make_reader
 from mcap.records import Chunk
 from mcap.stream_reader import ReadDataStream, get_chunk_data_stream
-from mcap_protobuf.decoder import DecoderFactory
 
 from pipeline.core import files, layouts, markers, robot, schemas
+from pipeline.core.decoding import entry_labels, read_topics
 from pipeline.core.encoding import encode_series
 from pipeline.robotics.transforms import quaternion_wxyz
 
@@ -39,6 +38,7 @@ CONFIG_ATTACHMENT = "config.yaml"
 MODEL_ATTACHMENT = "model.xml"   # the generated MuJoCo model (MJCF) a run simulates
 CHUNK_BYTES = 1024 * 1024
 COMPRESSION = MCAPCompression.Lz4  # Foxglove, Rerun and the mcap reader all read it; half zstd's cost per message
+UNITS_KEY = "units"   # channel metadata: JSON column -> unit
 # Topics that carry the simulated state: a NaN or an infinity there means the simulation diverged, and the
 # run fails with the first time it happened (every paper gets this watchdog by logging these topics).
 STATE_TOPICS = ("/joint_state", "/tracking_error", "/wrench", "/command")
@@ -92,6 +92,64 @@ def _file_descriptor_set(descriptor: Descriptor) -> bytes:
     return fds.SerializeToString()
 
 
+EntryUnits = str | Sequence[str] | None
+
+
+def column_units(cls: type[Message], sample: Mapping[str, Any], units: EntryUnits = None,
+                 field_units: Mapping[str, EntryUnits] | None = None, topic: str = "") -> dict[str, str]:
+    """Column -> unit of the record `sample` (field -> value) of schema `cls`: the schema's unit of each field,
+    with its entry template ("q", "q/s", ...) filled from `units` (each named entry's unit) and `field_units`
+    taking precedence. Raises ValueError naming the column whose unit nobody gave."""
+    declared = schemas.units_of(cls)
+    field_units = dict(field_units or {})
+    unknown = set(field_units) - set(cls.DESCRIPTOR.fields_by_name)
+    if unknown:
+        raise ValueError(f"{topic}: field_units names no field of {cls.DESCRIPTOR.full_name}: {sorted(unknown)}")
+    names = sample.get("name")
+    names = None if names is None or isinstance(names, str) else list(names)
+    kind = sample.get("kind", "")
+    kind = kind if isinstance(kind, str) else ""
+
+    def entries(spec: EntryUnits, count: int, what: str) -> list[str | None]:
+        if spec is None or isinstance(spec, str):
+            return [spec] * count
+        if len(spec) != count:
+            raise ValueError(f"{topic}: {what} gives {len(spec)} units for {count} entries")
+        return list(spec)
+
+    result: dict[str, str] = {}
+    for fd in cls.DESCRIPTOR.fields:
+        field = fd.name
+        if field == "name" or fd.type == fd.TYPE_STRING or (field not in sample and field not in declared):
+            continue
+        template = declared.get(field)
+        repeated = fd.is_repeated if hasattr(fd, "is_repeated") else fd.label == fd.LABEL_REPEATED
+        if repeated:
+            count = int(np.size(sample.get(field, ())))
+            if not count:
+                continue
+            labels = entry_labels(field, count, names)
+            explicit = entries(field_units[field], count, f"field_units[{field!r}]") if field in field_units \
+                else [None] * count
+            q = entries(units, count, "units")
+            found = [e or (schemas.derive(template, qi, kind) if template else None)
+                     for e, qi in zip(explicit, q, strict=True)]
+        else:
+            labels = [field]
+            common = {units} if isinstance(units, str) else set(units or [None])
+            q = next(iter(common)) if len(common) == 1 else None
+            spec = field_units.get(field)
+            found = [spec if isinstance(spec, str) else (schemas.derive(template, q, kind) if template else None)]
+        for label, unit in zip(labels, found, strict=True):
+            if not unit:
+                hint = (f"field_units={{'{field}': ...}}" if not repeated or template is None
+                        or schemas.ENTRY not in template.replace("effort", "")
+                        else "units= (each named entry's unit, e.g. units='rad')")
+                raise ValueError(f"{topic}: the unit of {label} is not known: pass {hint}")
+            result[label] = unit
+    return result
+
+
 class RunWriter:
     """Writes one run. Use as a context manager; `close(status)` publishes the file.
 
@@ -109,6 +167,8 @@ class RunWriter:
         self._open = True
         self._types: dict[str, type[Message] | tuple] = {}  # protobuf class, or robot.ROS2_STRING
         self._pending: dict[str, list[tuple[np.ndarray, list[bytes]]]] = {}
+        self._units: dict[str, dict[str, str]] = {}   # topic -> column -> unit, written as channel metadata
+        self._declared: set[tuple] = set()
         self.metadata = {k: v if isinstance(v, str) else json.dumps(v) for k, v in metadata.items()}
         self._model_xml: str | None = None
         self._joint_state: tuple[np.ndarray, list[str], np.ndarray] | None = None
@@ -138,18 +198,27 @@ class RunWriter:
         """Queue a ready-made message at simulated time `t_ns`."""
         self._queue(topic, type(message)).append((np.array([t_ns], dtype=np.int64), [message.SerializeToString()]))
 
-    def log(self, topic: str, t: float, message_type: type[Message] | None = None, **fields: Any) -> None:
-        """Write one record at simulated time `t` (s); common topics know their schema."""
+    def log(self, topic: str, t: float, message_type: type[Message] | None = None, *, units: EntryUnits = None,
+            field_units: Mapping[str, EntryUnits] | None = None, **fields: Any) -> None:
+        """Write one record at simulated time `t` (s); common topics know their schema. `units` and
+        `field_units` say what the schema leaves to the writer (see `log_series`)."""
         cls = message_type or self._schema(topic)
         if _is_state(topic):
             _watch(topic, np.array([t]), {k: v for k, v in fields.items() if not isinstance(v, str)})
+        self._declare(topic, cls, fields, units, field_units)
         self.write(topic, seconds_to_ns(t), cls(**fields))
 
-    def log_series(self, topic: str, times: np.ndarray, message_type: type[Message] | None = None,
+    def log_series(self, topic: str, times: np.ndarray, message_type: type[Message] | None = None, *,
+                   units: EntryUnits = None, field_units: Mapping[str, EntryUnits] | None = None,
                    **columns: Any) -> None:
         """Write one record per sample: a NumPy array column gives sample i its row i (a 1-D array
         fills a scalar field, a 2-D array a repeated one); anything else (names as a list, a string) is
-        the same in every record."""
+        the same in every record.
+
+        Every number has a unit. The schema fixes most (`/wrench` forces in N); where it says "q" (a joint's
+        position, a Scalars value) the writer gives each named entry's unit: `units="rad"` for all of them, or
+        one per name (`units=["rad", "rad", "m"]`); velocities, efforts and commands follow from it (rad -> rad/s,
+        N*m). `field_units={"norm": "m"}` sets a field's unit (or one per entry) outright."""
         cls = message_type or self._schema(topic)
         times_ns = seconds_to_ns(np.asarray(times, dtype=float))
         per_sample = {k: v for k, v in columns.items() if isinstance(v, np.ndarray)}
@@ -159,6 +228,8 @@ class RunWriter:
                 raise ValueError(f"{topic}: column {k} has {len(v)} samples for {len(times_ns)} times")
         if _is_state(topic):
             _watch(topic, np.asarray(times, dtype=float), per_sample)
+        self._declare(topic, cls, {**constant, **{k: v[0] if len(v) else v for k, v in per_sample.items()}},
+                      units, field_units)
         if topic == "/joint_state" and "position" in per_sample and self._joint_state is None:
             self._joint_state = (np.asarray(times, dtype=float), list(constant.get("name", [])),
                                  np.asarray(per_sample["position"], dtype=float).reshape(len(times_ns), -1))
@@ -169,6 +240,24 @@ class RunWriter:
                        for i in range(len(times_ns))]
         self._queue(topic, cls).append((times_ns, encoded))
 
+    def _declare(self, topic: str, cls: type[Message], sample: Mapping[str, Any], units: EntryUnits,
+                 field_units: Mapping[str, EntryUnits] | None) -> None:
+        """Record the unit of every column one record of `topic` makes (the first time this shape is logged)."""
+        names = sample.get("name")
+        names = None if names is None or isinstance(names, str) else list(names)
+        self._queue(topic, cls)  # the topic's schema first: a reserved topic refuses another
+        key = (topic, cls, tuple(names or ()), sample.get("kind", ""),
+               units if units is None or isinstance(units, str) else tuple(units),
+               tuple((k, v if isinstance(v, str) else tuple(v)) for k, v in (field_units or {}).items()),
+               tuple((k, len(v) if isinstance(v, list | tuple | np.ndarray) else -1) for k, v in sample.items()))
+        if key in self._declared:
+            return
+        self._declared.add(key)
+        known = self._units.setdefault(topic, {})
+        for column, unit in column_units(cls, sample, units, field_units, topic).items():
+            if known.setdefault(column, unit) != unit:
+                raise ValueError(f"{topic}: column {column} was logged in {known[column]}, now in {unit}")
+
     def log_transforms(self, times: np.ndarray, parent: str, children: Sequence[str],
                        matrices: np.ndarray, topic: str = "/tf") -> None:
         """Foxglove FrameTransforms: `matrices` (N, k, 4, 4) are the poses of the k `children` in
@@ -178,6 +267,10 @@ class RunWriter:
         encoded = robot.frame_transforms(times_ns, [parent] * len(children), children, matrices[..., :3, 3],
                                          quaternion_wxyz(matrices[..., :3, :3]))
         self._queue(topic, schemas.FrameTransforms).append((times_ns, encoded))
+        known = self._units.setdefault(topic, {})
+        for c in children:
+            known.update({f"transforms.{c}.translation.{a}": "m" for a in "xyz"})
+            known.update({f"transforms.{c}.rotation.{a}": "1" for a in "xyzw"})
 
     @property
     def model_xml(self) -> str | None:
@@ -288,8 +381,9 @@ class RunWriter:
                 schema = foxglove.Schema(name=kind.DESCRIPTOR.full_name, encoding="protobuf",
                                          data=_file_descriptor_set(kind.DESCRIPTOR))
                 message_encoding = "protobuf"
-            channel = foxglove.Channel(topic, schema=schema, message_encoding=message_encoding,
-                                       context=self._context)
+            units = self._units.get(topic)
+            channel = foxglove.Channel(topic, schema=schema, message_encoding=message_encoding, context=self._context,
+                                       metadata={UNITS_KEY: json.dumps(units)} if units else None)
             times = np.concatenate([t for t, _ in parts])
             data = [b for _, chunk in parts for b in chunk]
             if len(times) > 1 and (np.diff(times) < 0).any():
@@ -349,7 +443,12 @@ class Run:
             summary = reader.get_summary()
         if not self.metadata:
             raise ValueError(f"{self.path} has no '{METADATA_NAME}' metadata record: not a complete run file")
-        self.topic_names = sorted({c.topic for c in summary.channels.values()}) if summary else []
+        channels = summary.channels.values() if summary else []
+        self.topic_names = sorted({c.topic for c in channels})
+        self._units = {c.topic: json.loads(c.metadata.get(UNITS_KEY, "{}")) for c in channels}
+        self._schemas = {c.topic: summary.schemas[c.schema_id].name for c in channels}
+        counts = summary.statistics.channel_message_counts if summary and summary.statistics else {}
+        self._counts = {c.topic: counts.get(i, 0) for i, c in (summary.channels.items() if summary else [])}
         self._frames: dict[str, pd.DataFrame] = {}
 
     def __repr__(self) -> str:
@@ -385,8 +484,25 @@ class Run:
 
     @property
     def params(self) -> dict[str, Any]:
-        """The command-line overrides that distinguish this run in a sweep."""
-        return json.loads(self.metadata.get("params", "{}"))
+        """What distinguishes this run in a sweep or a set of episodes: its overrides and sampled values, typed
+        (numbers as numbers) from the resolved config."""
+        values = self.metadata.get("values")
+        if values is not None:
+            return json.loads(values)
+        return {k: typed(v) for k, v in json.loads(self.metadata.get("params", "{}")).items()}
+
+    def schema_name(self, topic: str) -> str:
+        """The full name of a topic's schema (`repro.JointState`, `foxglove.FrameTransforms`, ...)."""
+        return self._schemas[topic]
+
+    def message_count(self, topic: str) -> int:
+        return self._counts.get(topic, 0)
+
+    def units(self, topic: str) -> dict[str, str]:
+        """Column -> unit of a topic (what the writer declared; Foxglove schemas: metres, unit quaternions)."""
+        if topic not in self.topic_names:
+            raise KeyError(f"{self.path.name} has no topic {topic}; it has {self.topic_names}")
+        return dict(self._units.get(topic, {}))
 
     @property
     def topics(self) -> dict[str, pd.DataFrame]:
@@ -397,83 +513,10 @@ class Run:
         if topic not in self._frames:
             if topic not in self.topic_names:
                 raise KeyError(f"{self.path.name} has no topic {topic}; it has {self.topic_names}")
-            self._frames.update(_decode(self.path, [topic]))
+            for name, frame in read_topics(self.path, [topic]).items():
+                frame.attrs["units"] = self._units.get(name, {})
+                self._frames[name] = frame
         return self._frames[topic]
-
-
-def _is_repeated(fd: FieldDescriptor) -> bool:
-    return fd.is_repeated if hasattr(fd, "is_repeated") else fd.label == FieldDescriptor.LABEL_REPEATED
-
-
-@functools.cache
-def _plan(descriptor: Descriptor) -> tuple[bool, tuple[tuple[str, bool, bool, bool], ...]]:
-    """(labels entries by `name`, [(field, repeated, is_message, optional scalar)]) without the timestamp."""
-    name = descriptor.fields_by_name.get("name")
-    labelled = name is not None and _is_repeated(name)
-    fields = tuple((fd.name, _is_repeated(fd), fd.message_type is not None,
-                    fd.message_type is None and not _is_repeated(fd) and fd.has_presence) for fd in descriptor.fields
-                   if not (fd.message_type is not None and fd.message_type.full_name == "google.protobuf.Timestamp")
-                   and not (labelled and fd.name == "name"))
-    return labelled, fields
-
-
-def _flatten(message: Message, prefix: str, row: dict[str, Any]) -> None:
-    """Message -> flat columns. Repeated scalars are labelled by the message's `name` list if it has
-    one of the same length (`position.shoulder`), else by index (`position[0]`); repeated messages by
-    their `child_frame_id`/`name` if they carry one."""
-    labelled, fields = _plan(message.DESCRIPTOR)
-    names = list(message.name) if labelled else None
-    for field_name, repeated, is_message, optional in fields:
-        if optional and not message.HasField(field_name):
-            continue  # an optional field left out (a joint's velocity) is no column, not a zero
-        value = getattr(message, field_name)
-        key = prefix + field_name
-        if repeated and is_message:
-            for i, item in enumerate(value):
-                label = getattr(item, "child_frame_id", "") or getattr(item, "name", "") or str(i)
-                _flatten(item, f"{key}.{label}.", row)
-        elif repeated:
-            if names is not None and len(names) == len(value):
-                row.update(zip([f"{key}.{n}" for n in names], value, strict=True))
-            else:
-                row.update((f"{key}[{i}]", v) for i, v in enumerate(value))
-        elif is_message:
-            _flatten(value, key + ".", row)
-        else:
-            row[key] = value
-
-
-class _Ros2StringDecoder:
-    """Decodes the ROS 2 `std_msgs/msg/String` channels (`/robot_description`) as a one-field message."""
-
-    def decoder_for(self, message_encoding: str, schema):
-        if message_encoding == "cdr" and schema is not None and schema.name == robot.ROS2_STRING[0]:
-            return lambda payload: {"data": robot.decode_ros2_string(payload)}
-        return None
-
-
-def _decode(path: Path, topics: Iterable[str]) -> dict[str, pd.DataFrame]:
-    import pandas as pd
-
-    rows: dict[str, list[dict[str, Any]]] = {}
-    times: dict[str, list[int]] = {}
-    with open(path, "rb") as f:
-        reader = make_reader(f, decoder_factories=[DecoderFactory(), _Ros2StringDecoder()])
-        # file order, not a global log-time merge (costly); each topic is sorted on its own below
-        for _schema, channel, message, decoded in reader.iter_decoded_messages(topics=list(topics),
-                                                                                log_time_order=False):
-            row: dict[str, Any] = {}
-            if isinstance(decoded, dict):
-                row.update(decoded)
-            else:
-                _flatten(decoded, "", row)
-            rows.setdefault(channel.topic, []).append(row)
-            times.setdefault(channel.topic, []).append(message.log_time)
-    frames = {}
-    for topic, topic_rows in rows.items():
-        index = pd.Index(np.asarray(times[topic], dtype=np.int64) / 1e9, name="t")
-        frames[topic] = pd.DataFrame.from_records(topic_rows, index=index).sort_index(kind="stable")
-    return frames
 
 
 def read_run(path: str | Path) -> Run:
@@ -487,5 +530,69 @@ def run_files(directory: str | Path) -> list[Path]:
     return sorted(p for p in directory.glob(f"*{RUN_SUFFIX}") if not p.name.startswith("."))
 
 
-def read_runs(directory: str | Path) -> list[Run]:
-    return [read_run(p) for p in run_files(directory)]
+def typed(text: str) -> Any:
+    """A command-line value as Hydra types it: 4 -> int, 0.5 and 1e-4 -> float, true -> bool, null -> None,
+    [a,b] -> list; anything else stays a string."""
+    if not isinstance(text, str):
+        return text
+    value = text.strip()
+    lowered = value.lower()
+    if lowered in ("true", "false"):
+        return lowered == "true"
+    if lowered == "null":
+        return None
+    if value.startswith("[") and value.endswith("]"):
+        inner = value[1:-1].strip()
+        return [typed(x) for x in inner.split(",")] if inner else []
+    for kind in (int, float):
+        try:
+            return kind(value)
+        except ValueError:
+            pass
+    return value
+
+
+class Runs(list):
+    """The runs of an experiment, a sweep or a set of episodes; `table()` and `frame(topic)` make tidy tables."""
+
+    def table(self) -> pd.DataFrame:
+        """One row per run: run_id, status, case, episode, seed, wall time and every parameter, typed."""
+        import pandas as pd
+
+        rows = []
+        for run in self:
+            meta = run.metadata
+            rows.append({"run_id": run.run_id, "status": run.status, "case": meta.get("case", ""),
+                         "episode": int(meta["episode"]) if "episode" in meta else pd.NA,
+                         "seed": typed(meta.get("seed", "")),
+                         "wall_time_s": float(meta.get("wall_time_s", "nan")), **run.params})
+        return pd.DataFrame(rows)
+
+    def frame(self, topic: str, columns: list[str] | None = None, ok_only: bool = True) -> pd.DataFrame:
+        """One tidy DataFrame of `topic` over every run: run_id, the run's parameters (typed), t, then the
+        topic's columns (all, or `columns`). Runs without the topic are left out; units in `.attrs["units"]`."""
+        parts, units = [], {}
+        for run in self:
+            if (ok_only and not run.ok) or topic not in run.topic_names:
+                continue
+            data = run[topic] if columns is None else run[topic][columns]
+            units.update({c: u for c, u in run.units(topic).items() if c in data.columns})
+            head = pd.DataFrame({"run_id": run.run_id, **{k: [v] * len(data) if isinstance(v, list) else v
+                                                           for k, v in run.params.items()}}, index=data.index)
+            parts.append(pd.concat([head, data], axis=1).reset_index())
+        frame = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=["run_id", "t"])
+        frame.attrs["units"] = units
+        return frame
+
+
+def read_runs(source: str | Path | Iterable[str | Path], topic: str | None = None) -> Runs | pd.DataFrame:
+    """The runs of a directory (an experiment, a sweep, a set of episodes) or of a list of files/directories.
+
+    With `topic`, one tidy DataFrame of that topic over all of them (`Runs.frame`): a whole sweep in one call,
+    swept parameters as typed columns (numbers as numbers)."""
+    paths: list[Path] = []
+    for item in [source] if isinstance(source, str | Path) else source:
+        item = Path(item)
+        paths += run_files(item) if item.is_dir() else [item]
+    runs = Runs(read_run(p) for p in paths)
+    return runs.frame(topic) if topic is not None else runs

@@ -4,27 +4,24 @@ from __future__ import annotations
 
 import datetime as dt
 import hashlib
-import multiprocessing
-import os
 import re
-import signal
 import sys
 import time
 import traceback
-from collections.abc import Iterator
 from pathlib import Path
 
-from omegaconf import DictConfig, OmegaConf
+import yaml
+from omegaconf import DictConfig, ListConfig, OmegaConf
 from tqdm import tqdm
 
-from pipeline.core import interrupts, provenance, stages
+from pipeline.core import episodes, interrupts, parallel, provenance, stages
 from pipeline.core.checks import BadInput, check_cases
 from pipeline.core.experiment import resolve
 from pipeline.core.files import Busy, Locks, stale_partials
-from pipeline.core.runlog import CONFIG_ATTACHMENT, RunWriter, SimulationFailed
+from pipeline.core.runlog import CONFIG_ATTACHMENT, RunWriter, SimulationFailed, typed
 
 # Overrides that do not change what is simulated, so they do not name a run.
-NOT_PARAMS = ("experiment", "data_dir", "sweep_dir", "progress", "workers")
+NOT_PARAMS = ("experiment", "data_dir", "sweep_dir", "progress", "workers", "episodes.count")
 MAX_ID = 120
 
 
@@ -36,6 +33,16 @@ def run_params(overrides: list[str]) -> dict[str, str]:
         if key not in NOT_PARAMS and not key.startswith("hydra"):
             params[key] = value
     return params
+
+
+def run_values(cfg: DictConfig, params: dict[str, str]) -> dict:
+    """The overrides' values as the resolved config holds them: typed (numbers as numbers, lists as lists)."""
+    values = {}
+    for key in params:
+        value = OmegaConf.select(cfg, key, default=None, throw_on_missing=False)
+        value = OmegaConf.to_container(value, resolve=True) if isinstance(value, DictConfig | ListConfig) else value
+        values[key] = typed(params[key]) if value is None else value
+    return values
 
 
 def run_id(case: str, params: dict[str, str]) -> str:
@@ -66,7 +73,8 @@ def simulate(cfg: DictConfig, experiment_id: str, overrides: list[str] | None = 
     out_dir = data_dir / "runs" / slug / name
     config_yaml = OmegaConf.to_yaml(cfg, resolve=True)
     cases = check_cases(cfg, experiment)
-    ids = [run_id(case.id, params) for case in cases]
+    names = [f"episode-{i:06d}" for i in range(cfg.episodes.count)] or [case.id for case in cases]
+    ids = [run_id(name, params) for name in names]
     interrupts.install()
     locks = Locks(data_dir, [f"{slug}/{name}/{rid}" for rid in ids])
     try:
@@ -75,79 +83,65 @@ def simulate(cfg: DictConfig, experiment_id: str, overrides: list[str] | None = 
         raise BadInput(f"another process is writing run {busy} under {data_dir}: wait for it, or use another "
                        "data_dir") from None
     errors = 0
-    common = {"slug": slug, "experiment": name, "seed": str(cfg.seed), "params": params,
-              "git_revision": provenance.git_revision(), "package_versions": provenance.package_versions(),
-              "machine": provenance.machine()}
-    alone = experiment.timed or any(case.shares_work for case in cases)
-    workers = 1 if alone else min(worker_count(cfg.get("workers", 0)), len(cases))
-    common["parallel_runs"] = str(workers)  # a compute time logged beside other runs says so
-    jobs = [(case, rid, out_dir, config_yaml, {**common, "run_id": rid, "case": case.id})
-            for case, rid in zip(cases, ids, strict=True)]
     try:
         for rid in ids:  # left by writers that died: nobody else can hold these names now
             for stale in stale_partials(out_dir / f"{rid}.mcap"):
                 stale.unlink(missing_ok=True)
-        bar = tqdm(total=len(jobs), desc=experiment_id, unit="run", disable=None if cfg.progress else True,
+        bar = tqdm(total=len(ids), desc=experiment_id, unit="run", disable=None if cfg.progress else True,
                    leave=False, file=sys.stderr)
+        alone = experiment.timed or any(case.shares_work for case in cases)
+        workers = 1 if alone else parallel.workers_for(cfg.workers, len(ids))
         stages.mark("first_step")
-        results = _in_processes(jobs, workers) if workers > 1 else (_run_case(*job) for job in jobs)
-        for rid, status, bug in results:
+        for rid, status, bug in _runs(cfg, experiment, cases, ids, out_dir, config_yaml, workers, {
+                "slug": slug, "experiment": name, "params": params, "values": run_values(cfg, params),
+                "git_revision": provenance.git_revision(), "package_versions": provenance.package_versions(),
+                "machine": provenance.machine(), "parallel_runs": str(workers)}):  # beside a logged compute time
             bar.update()
-            bar.set_postfix_str(rid)
             errors += bug
             tqdm.write(f"{experiment_id} {rid}: {status}" if status != "ok" else f"wrote {out_dir / rid}.mcap",
                        file=sys.stderr)
         bar.close()
     finally:
+        for rid in ids:  # what workers stopped by an interrupt left unfinished
+            for stale in stale_partials(out_dir / f"{rid}.mcap"):
+                stale.unlink(missing_ok=True)
         locks.release()
     return errors
 
 
-def worker_count(requested: int) -> int:
-    """`workers=0` means one process per core this process may use."""
-    if requested:
-        return requested
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+def _runs(cfg: DictConfig, experiment, cases, ids: list[str], out_dir: Path, config_yaml: str, workers: int,
+          metadata: dict):
+    """(run id, status, bug) of every run, on `workers` processes: the experiment's cases, or its episodes.
+
+    A TIMED experiment, or one whose cases share work, runs on one: its runs one after another, alone (DVC
+    runs one stage at a time)."""
+    if not cfg.episodes.count:
+        def run(index: int) -> tuple[str, str, bool]:
+            case, rid = cases[index], ids[index]
+            return rid, *_run_case(case, rid, out_dir, config_yaml, {
+                **metadata, "run_id": rid, "case": case.id, "seed": str(cfg.seed)})
+
+        yield from parallel.imap(run, range(len(cases)), workers)
+        return
+    described = {key: episodes.describe(dist) for key, dist in episodes.randomized(cfg).items()}
+    base = OmegaConf.to_container(cfg, resolve=True)
+
+    def episode(index: int) -> tuple[str, str, bool]:
+        values = episodes.draw(cfg, index)
+        plain = episodes.apply(base, values, episodes.seed_of(cfg, index))
+        case = experiment.fn(OmegaConf.create(plain))[0]
+        status, bug = _run_case(case, ids[index], out_dir, yaml.safe_dump(plain, sort_keys=False), {
+            **metadata, "run_id": ids[index], "case": case.id, "seed": str(plain["seed"]), "episode": str(index),
+            "episodes_seed": str(cfg.seed), "randomized": described, "values": {**metadata["values"], **values}})
+        return ids[index], status, bug
+
+    yield from parallel.imap(episode, range(cfg.episodes.count), workers)
 
 
-_JOBS: list[tuple] = []  # the cases of the stage, inherited by forked workers (closures do not pickle)
-
-
-def _run_job(index: int) -> tuple[str, str, bool]:
-    return _run_case(*_JOBS[index])
-
-
-def _start_worker() -> None:
-    # The stage alone takes interrupts: it stops the workers (SIGTERM, which ends them at once) and removes
-    # the runs they left unfinished. A worker whose stage is killed outright ends too.
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    interrupts.die_with_parent()
-
-
-def _in_processes(jobs: list[tuple], workers: int) -> Iterator[tuple[str, str, bool]]:
-    """Run the cases in `workers` forked processes, yielding results as they finish.
-
-    Cases are closures over the experiment's config, so the workers are forked after the cases are built and
-    receive an index."""
-    _JOBS[:] = jobs
-    pool = multiprocessing.get_context("fork").Pool(workers, initializer=_start_worker)
-    try:
-        yield from pool.imap_unordered(_run_job, range(len(jobs)))
-        pool.close()
-    finally:
-        pool.terminate()
-        pool.join()
-        _JOBS.clear()
-        for _, rid, out_dir, *_ in jobs:
-            for partial in stale_partials(out_dir / f"{rid}.mcap"):
-                partial.unlink(missing_ok=True)
-
-
-def _run_case(case, rid: str, out_dir: Path, config_yaml: str, metadata: dict) -> tuple[str, str, bool]:
-    """Simulate one case into its run file; (run id, status, whether a bug rather than physics failed it)."""
+def _run_case(case, rid: str, out_dir: Path, config_yaml: str, metadata: dict) -> tuple[str, bool]:
+    """Simulate one case into its run file; (status, whether a bug rather than physics failed it)."""
     bug = False
-    metadata["created"] = dt.datetime.now(dt.UTC).isoformat(timespec="seconds")
+    metadata = {**metadata, "created": dt.datetime.now(dt.UTC).isoformat(timespec="seconds")}
     with RunWriter(out_dir / f"{rid}.mcap", metadata) as writer:
         writer.attach(CONFIG_ATTACHMENT, config_yaml, "application/yaml")
         start = time.perf_counter()
@@ -164,4 +158,4 @@ def _run_case(case, rid: str, out_dir: Path, config_yaml: str, metadata: dict) -
         interrupts.raise_if_received()  # swallowed entirely: the run may be cut short, do not publish it
         writer.metadata["wall_time_s"] = f"{time.perf_counter() - start:.3f}"
         writer.close(status)
-    return rid, status, bug
+    return status, bug

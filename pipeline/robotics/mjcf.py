@@ -171,3 +171,13 @@ def check_mujoco(data, states: np.ndarray, times: np.ndarray) -> None:
         if warning.number:
             raise SimulationFailed(f"MuJoCo {name.removeprefix('mjWARN_')} ({warning.number}×): the simulation "
                                    "diverged (time step too large for the gains?)")
+
+
+def qpos_units(model) -> list[str]:
+    """The unit of each qpos coordinate of a MuJoCo model (what `/joint_state` needs): rad for a hinge, m for a
+    slide, m and a unit quaternion (1) for a free joint's position and orientation, 1 for a ball's quaternion."""
+    import mujoco
+
+    per_type = {mujoco.mjtJoint.mjJNT_HINGE: ["rad"], mujoco.mjtJoint.mjJNT_SLIDE: ["m"],
+                mujoco.mjtJoint.mjJNT_BALL: ["1"] * 4, mujoco.mjtJoint.mjJNT_FREE: ["m"] * 3 + ["1"] * 4}
+    return [u for kind in model.jnt_type for u in per_type[mujoco.mjtJoint(kind)]]

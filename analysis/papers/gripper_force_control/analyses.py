@@ -152,7 +152,8 @@ def analyze_tables(runs: list[Run], figures: Figures) -> pd.DataFrame:
         # the paper's own arithmetic (consistency): its printed speed over each competitor's
         values |= {f"table3.{slug(g)}.printed_arithmetic": (speed[OURS] / v, "ratio")
                    for g, v in speed.drop(OURS).items()}
-        text = rows[rows["table"] == "text"].set_index("gripper")["value.value"]
+        text = pd.Series({row.gripper: row[f"value.{row.gripper}"]
+                          for _, row in rows[rows["table"] == "text"].iterrows()})
         cycle = 2 * text["open_close_time"] + text["lift_rotate_time"]
         values |= {"text.cycle_time": (cycle, "s"), "text.rate": (60.0 / text["cycle_time"], "1/min"),
                    "text.tomato_force_limit": tomato_force_limit(text["force_error"])}

@@ -8,7 +8,7 @@ import pandas as pd
 from analysis.core.compute_time import timing_metrics
 from analysis.core.figures import Figures
 from analysis.core.metrics import MetricTable
-from analysis.papers.ur5_ik_fsm.figures import _path_figure, _per_call_figure, _table6_figure
+from analysis.papers.ur5_ik_fsm.figures import _episodes_figure, _path_figure, _per_call_figure, _table6_figure
 from analysis.papers.ur5_ik_fsm.metrics import AGREE_TOL, ALGORITHMS, JOINT_COLUMNS, _nonsingular, _path_metrics, wrap
 from pipeline.core.runlog import Run
 
@@ -90,5 +90,20 @@ def analyze_compute_time(runs: list[Run], figures: Figures) -> pd.DataFrame:
     return m.frame()
 
 
+def analyze_random_paths(runs: list[Run], figures: Figures) -> pd.DataFrame:
+    """Randomized episodes (our dataset generator): the singular-paths metrics of each, with what was drawn."""
+    m = MetricTable()
+    for run in runs:
+        values, _, _ = _path_metrics(run)
+        path, crossing, alg = run.metadata["case"].split("-")
+        for metric, (value, unit) in values.items():
+            m.add(run.run_id, metric, value, unit, {**run.params, "path": path, "crossing": crossing,
+                                                     "algorithm": alg})
+    frame = m.frame()
+    if not frame.empty:
+        _episodes_figure(frame, figures)
+    return frame
+
+
 ANALYSES = {"tables": analyze_tables, "singular-paths": analyze_singular_paths,
-            "compute-time": analyze_compute_time}
+            "random-paths": analyze_random_paths, "compute-time": analyze_compute_time}

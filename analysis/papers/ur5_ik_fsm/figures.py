@@ -81,3 +81,23 @@ def _per_call_figure(run_id: str, stats: dict[str, np.ndarray], figures: Figures
     ax.set_title(f"{run_id}: scalar (per call) and batched (per pose)")
     ax.legend()
     figures.save(fig, f"{run_id}-per-call")
+
+
+def _episodes_figure(metrics: pd.DataFrame, figures: Figures) -> None:
+    """Per randomized episode: the executed flange error against the servo bandwidth drawn for it, by path
+    (colour) and algorithm (marker), and the largest IK joint jump."""
+    wide = metrics.pivot_table(index=["run_id", "path", "algorithm", "execute.bandwidth_hz"], columns="metric",
+                               values="value").reset_index()
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
+    colours = {"wrist": "tab:blue", "shoulder": "tab:orange", "elbow": "tab:green"}
+    for (path, alg), group in wide.groupby(["path", "algorithm"]):
+        style = {"color": colours.get(path, "grey"), "marker": "o" if alg == "alg1" else "^", "ls": "none",
+                 "ms": 4, "alpha": 0.75, "label": f"{path}, {alg}"}
+        axes[0].plot(group["execute.bandwidth_hz"], group["max_flange_error"] * 1e3, **style)
+        axes[1].plot(group["execute.bandwidth_hz"], group["max_joint_jump"], **style)
+    axes[0].set(xlabel="servo bandwidth drawn (Hz)", ylabel="max flange error (mm)", yscale="log",
+                title="executed path error per episode")
+    axes[1].axhline(JUMP_THRESHOLD, color="k", lw=0.8, ls=":", label=f"jump threshold {JUMP_THRESHOLD} rad")
+    axes[1].set(xlabel="servo bandwidth drawn (Hz)", ylabel="max IK joint jump (rad)", title="IK selection")
+    axes[1].legend(fontsize=7, loc="center left", bbox_to_anchor=(1.0, 0.5))
+    figures.save(fig, "episodes")

@@ -17,9 +17,17 @@ from pipeline.core.runlog import RunWriter, SimulationFailed
 from pipeline.core.timing import time_calls
 from pipeline.papers.admittance_assembly import design, geometry, insertion, quasistatic
 from pipeline.papers.admittance_assembly.geometry import PegInHole
+from pipeline.robotics.mjcf import qpos_units
 
 TWIST_NAMES = np.array(["v_x", "v_y", "v_z", "w_x", "w_y", "w_z"])
 ERROR_NAMES = ["x", "y", "z"]
+CHART_UNITS = {True: ("rad", "m"), False: ("rad", "rad", "rad", "m", "m")}   # geometry.CHART's coordinates
+TWIST_NORM = "m/s & rad/s"   # the norm of a twist that mixes translation and rotation rates
+
+
+def twist_units(dofs: list[str]) -> list[str]:
+    """The coordinate of each twist entry: v_* translate (m), w_* turn (rad); the twist itself is per second."""
+    return ["m" if d.startswith("v") else "rad" for d in dofs]
 SAMPLE_DT = 1e-3  # s: samples that are not a trajectory (configurations, admittances) are logged 1 ms apart
 NEAR_GAP = 1e-4   # m: a MuJoCo contact is attributed to the nearest candidate within this gap
 CONTACT_SCALE = 0.005  # m/N: MuJoCo's contact forces (up to ~7 N) drawn 5 mm per newton beside the 5 cm peg
@@ -102,7 +110,7 @@ def to_six(g: PegInHole, x: np.ndarray) -> np.ndarray:
 def log_wrench(log: RunWriter, topic: str, t: np.ndarray, frame: str, names: list[str], wrench: np.ndarray) -> None:
     """`wrench` (N, k, 6) = [force; torque] of k named contacts or points."""
     wrench = np.asarray(wrench, float).reshape(len(t), len(names), 6)
-    log.log_series(topic, t, frame_id=frame, name=names, **{
+    log.log_series(topic, t, frame_id=frame, name=names, **{  # Wrench: N and N*m
         f: wrench[..., i] for i, f in enumerate(("force_x", "force_y", "force_z", "torque_x", "torque_y", "torque_z"))})
 
 
@@ -134,7 +142,8 @@ def corner_conditions(cfg: DictConfig) -> list[Case]:
             columns = np.column_stack([samples.coords, samples.margin(A_designed, speed),
                                        samples.margin(A_iso, speed), lam, samples.error, samples.valid])
             log.log_series(topic, np.arange(len(columns)) * SAMPLE_DT, schemas.Scalars, value=columns,
-                           name=[*names, "margin_designed", "margin_isotropic", "force_1", "force_2", "error", "valid"])
+                           name=[*names, "margin_designed", "margin_isotropic", "force_1", "force_2", "error", "valid"],
+                           units=[*CHART_UNITS[g.planar], "1", "1", "N", "N", "m", "1"])
 
         # many admittances: corners vs interior, and the two-PC model vs each contact alone (single PC)
         rng = np.random.default_rng(cfg.seed + 1)
@@ -151,7 +160,7 @@ def corner_conditions(cfg: DictConfig) -> list[Case]:
                        min(sample.margin(A, speed, slice(0, 1)).min(), corners.margin(A, speed, slice(0, 1)).min()),
                        min(sample.margin(A, speed, slice(1, 2)).min(), corners.margin(A, speed, slice(1, 2)).min()))
         log.log_series("/conditions/random", np.arange(len(rows)) * SAMPLE_DT, schemas.Scalars, value=rows,
-                       name=["corner_min", "interior_min", "single_1_min", "single_2_min"])
+                       name=["corner_min", "interior_min", "single_1_min", "single_2_min"], units="1")  # margins
 
         # compute time: one configuration per call, and one batched pass over the interior sample
         one = [(interior.W[i:i + 1], interior.d[i:i + 1], interior.v0[i:i + 1], interior.error[i:i + 1])
@@ -183,9 +192,9 @@ def log_trajectory(log: RunWriter, g: PegInHole, tr: insertion.Trajectory, speed
     t = tr.t[keep]
     dofs = TWIST_NAMES[g.dofs].tolist()
     v0 = geometry.nominal_twist(g, tr.R[keep], speed)
-    log.log_series("/reference", t, name=dofs, velocity=v0)
-    log.log_series("/command", t, kind="twist", name=dofs, value=tr.v[keep])
-    log.log_series("/tracking_error", t, name=ERROR_NAMES, error=tr.delta[keep],
+    log.log_series("/reference", t, units=twist_units(dofs), name=dofs, velocity=v0)
+    log.log_series("/command", t, units=twist_units(dofs), kind="twist", name=dofs, value=tr.v[keep])
+    log.log_series("/tracking_error", t, units="m", name=ERROR_NAMES, error=tr.delta[keep],
                    norm=np.linalg.norm(tr.delta[keep], axis=1))
     log_wrench(log, "/wrench", t, "peg", ["peg"], to_six(g, tr.w[keep]))
     pair = list(geometry.designated_pair(g))
@@ -196,6 +205,7 @@ def log_trajectory(log: RunWriter, g: PegInHole, tr: insertion.Trajectory, speed
     error = np.linalg.norm(tr.delta[keep], axis=1)
     log.log_series("/assembly", t, schemas.Scalars,
                    name=["error", "d_dot_v", "closing_rate", "active_contacts", "two_point_state", "min_gap"],
+                   units=["m", "m^2/s", "m/s", "1", "1", "m"],
                    value=np.column_stack([error, tr.d_dot_v[keep], -tr.d_dot_v[keep] / error,
                                           (tr.lam[keep] > 0).sum(axis=1), two_point, tr.gap[keep].min(axis=1)]))
 
@@ -270,7 +280,8 @@ def mujoco_crosscheck(cfg: DictConfig) -> list[Case]:
                                     active_gap=sc.active_gap)
             keep = np.unique(np.r_[np.arange(0, len(twin.t), max(1, round(sc.log_dt / sc.insertion_dt))),
                                    len(twin.t) - 1])
-            log.log_series("/tracking_error/quasi_static", twin.t[keep], name=ERROR_NAMES, error=twin.delta[keep],
+            log.log_series("/tracking_error/quasi_static", twin.t[keep], units="m", name=ERROR_NAMES,
+                           error=twin.delta[keep],
                            norm=np.linalg.norm(twin.delta[keep], axis=1))
             log_wrench(log, "/wrench/quasi_static", twin.t[keep], "peg", ["peg"], to_six(g, twin.w[keep]))
             log.metadata["quasi_static_outcome"] = twin.outcome
@@ -303,10 +314,10 @@ def _log_mujoco(log: RunWriter, g: PegInHole, sim, rows: list[dict], t: np.ndarr
     col = {k: np.array([r[k] for r in rows]) for k in rows[0] if k not in ("t", "points", "forces")}
     qpos_names = [sim.model.joint(i).name for i in range(sim.model.njnt)] if g.planar else \
         ["x", "y", "z", "qw", "qx", "qy", "qz"]
-    log.log_series("/joint_state", t, name=qpos_names, position=col["qpos"])
+    log.log_series("/joint_state", t, units=qpos_units(sim.model), name=qpos_names, position=col["qpos"])
     dofs = TWIST_NAMES[g.dofs].tolist()
-    log.log_series("/command", t, kind="twist", name=dofs, value=col["law"])
-    log.log_series("/tracking_error", t, name=ERROR_NAMES, error=col["delta"],
+    log.log_series("/command", t, units=twist_units(dofs), kind="twist", name=dofs, value=col["law"])
+    log.log_series("/tracking_error", t, units="m", name=ERROR_NAMES, error=col["delta"],
                    norm=np.linalg.norm(col["delta"], axis=1))
     log_wrench(log, "/wrench", t, "peg", ["peg"], to_six(g, col["w_meas"]))
     log_wrench(log, "/wrench/predicted", t, "peg", ["peg"], to_six(g, col["w_pred"]))
@@ -321,6 +332,7 @@ def _log_mujoco(log: RunWriter, g: PegInHole, sim, rows: list[dict], t: np.ndarr
     log.log_series("/assembly", t, schemas.Scalars,
                    name=["error", "twist_error", "law_residual", "mujoco_contacts", "predicted_contacts",
                          "penetration"],
+                   units=["m", TWIST_NORM, TWIST_NORM, "1", "1", "m"],
                    value=np.column_stack([error, np.linalg.norm(col["v"] - col["v_pred"], axis=1),
                                           np.linalg.norm(col["v"] - col["law"], axis=1), col["mujoco_contacts"],
                                           col["predicted_contacts"], col["penetration"]]))

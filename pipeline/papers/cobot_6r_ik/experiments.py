@@ -26,17 +26,18 @@ Candidate = schemas.define(
     "in m, angles in rad; errors are the algebraic candidate's, before any polishing; accepted: 0 rejected, "
     "1 a new solution, 2 a duplicate. c2_eq29 is eq. (29)'s c2 at the same c1; the *_paper fields take c3 from "
     "X4 and X6 (the pair Table 2's c3 imply), then P4 from eq. (18).",
-    c1="double", c1_imag="double", c2="double", c2_eq29="double", c3="double", c3_pairs="double[]",
-    p4="double[]", q_a="double[]", q_b="double[]", pos_err="double[]", rot_err="double[]",
-    accepted="double[]", lambda_residual="double",
-    c3_paper="double", p4_paper="double[]", q_paper_a="double[]", q_paper_b="double[]", pos_err_paper="double[]",
+    c1="double 1", c1_imag="double 1", c2="double 1", c2_eq29="double 1", c3="double 1", c3_pairs="double[] 1",
+    p4="double[] m", q_a="double[] rad", q_b="double[] rad", pos_err="double[] m", rot_err="double[] rad",
+    accepted="double[] 1", lambda_residual="double 1",
+    c3_paper="double 1", p4_paper="double[] m", q_paper_a="double[] rad", q_paper_b="double[] rad",
+    pos_err_paper="double[] m",
 )
 IkSample = schemas.define(
     "CobotIkSample", "Every IK solution of one flange pose (count × 6 joint angles in rad, row-major) and the one "
     "the branch follows; jump = largest joint step from the previous sample (rad); FK error of the "
     "followed solution (m, rad).",
-    count="uint32", solutions="double[]", name="string[]", followed="double[]", jump="double",
-    fk_error_position="double", fk_error_rotation="double",
+    count="uint32 1", solutions="double[] rad", name="string[]", followed="double[] rad", jump="double rad",
+    fk_error_position="double m", fk_error_rotation="double rad",
 )
 
 
@@ -85,21 +86,24 @@ def tables(cfg: DictConfig) -> list[Case]:
     def simulate(log: RunWriter, g: Geometry) -> None:
         T = fk(q31, g)
         F = dhk.frames(dhk.DH.from_config(g.dh), q31)
-        log.log("/example/pose", 0.0, schemas.Scalars, name=[f"T{r + 1}{c + 1}" for r in range(3) for c in range(4)],
+        log.log("/example/pose", 0.0, schemas.Scalars,
+                units=["m" if c == 3 else "1" for r in range(3) for c in range(4)],
+                name=[f"T{r + 1}{c + 1}" for r in range(3) for c in range(4)],
                 value=T[:3].ravel().tolist())
         points = {"P1": F[1], "P3": F[3], "P4": F[4], "P5": F[5], "P6": F[6]}
-        log.log("/example/points", 0.0, schemas.Scalars, name=[f"{k}.{a}" for k in points for a in "xyz"],
+        log.log("/example/points", 0.0, schemas.Scalars, units="m", name=[f"{k}.{a}" for k in points for a in "xyz"],
                 value=np.concatenate([M[:3, 3] for M in points.values()]).tolist())
         d = ik.diagnose(T, g, tol)
         order = np.lexsort((-d.roots.imag, d.roots.real))   # Table 2's order: by real part, +imag first
         roots = d.roots[order]
-        log.log("/ik/roots", 0.0, schemas.Scalars,
+        log.log("/ik/roots", 0.0, schemas.Scalars, units="1",
                 name=[f"root{k + 1:02d}.{p}" for k in range(len(roots)) for p in ("re", "im")],
                 value=np.column_stack([roots.real, roots.imag]).ravel().tolist())
-        log.log("/ik/lambda", 0.0, schemas.Scalars, name=[f"lambda{i:02d}" for i in range(17)], value=d.lam.tolist())
+        log.log("/ik/lambda", 0.0, schemas.Scalars, units="1", name=[f"lambda{i:02d}" for i in range(17)],
+                value=d.lam.tolist())
         octic = ik.diagnose(T, g, tol, "octic").roots   # ours: the roots of Λ's genuine factor alone
         octic = octic[np.lexsort((-octic.imag, octic.real))]
-        log.log("/ik/octic_roots", 0.0, schemas.Scalars,
+        log.log("/ik/octic_roots", 0.0, schemas.Scalars, units="1",
                 name=[f"root{k + 1:02d}.{p}" for k in range(len(octic)) for p in ("re", "im")],
                 value=np.column_stack([octic.real, octic.imag]).ravel().tolist())
         f, psi1, psi2, _ = rs.system(T, g.array)
@@ -121,12 +125,12 @@ def tables(cfg: DictConfig) -> list[Case]:
                     pos_err_paper=[float(np.linalg.norm(fk(x, g)[:3, 3] - T[:3, 3])) for x in q_paper])
         # the solutions, one per second: a replay of the paper's Fig. 3 (Foxglove / Rerun draw /tf)
         t = 1.0 + np.arange(len(d.q))
-        log.log_series("/ik/solutions", t, schemas.Reference, name=JOINTS, position=d.q)
-        log.log_series("/joint_state", t, name=JOINTS, position=d.q)
+        log.log_series("/ik/solutions", t, schemas.Reference, units="rad", name=JOINTS, position=d.q)
+        log.log_series("/joint_state", t, units="rad", name=JOINTS, position=d.q)
         frames = dhk.frames(dhk.DH.from_config(g.dh), d.q)[:, 1:]
         log.log_transforms(t, "base", [f"link{i}" for i in range(1, 7)], frames)
         ref = reference.multistart(T, int(sc.reference_starts), np.random.default_rng(cfg.seed), g)
-        log.log_series("/ik/reference", np.arange(len(ref), dtype=float), schemas.Reference, name=JOINTS,
+        log.log_series("/ik/reference", np.arange(len(ref), dtype=float), schemas.Reference, units="rad", name=JOINTS,
                        position=ref)
         log.attach("model.xml", arm_model(cfg, g, q31), "application/xml")
 
@@ -147,7 +151,7 @@ def completeness(cfg: DictConfig) -> list[Case]:
         poses = fk(q, g)
         c_gen = np.linalg.norm(cayley_params(dhk.frames(dhk.DH.from_config(g.dh), q)[:, 4, :3, :3]), axis=1)
         t = np.arange(len(q)) * 1e-3   # one sample per pose, 1 ms apart on the log's time axis
-        log.log_series("/completeness/generating", t, schemas.Reference, name=JOINTS, position=q)
+        log.log_series("/completeness/generating", t, schemas.Reference, units="rad", name=JOINTS, position=q)
         solutions = {}
         for method in ik.METHODS:
             rows = np.zeros((len(q), 7))
@@ -162,7 +166,7 @@ def completeness(cfg: DictConfig) -> list[Case]:
                            int(np.sum(np.abs(d.roots.imag) <= 1e-9 * np.maximum(1, np.abs(d.roots.real)))),
                            int((acc == 0).all(axis=1).sum()), c_gen[k])
             solutions[method] = found_sets
-            log.log_series(f"/completeness/{method}", t, schemas.Scalars, value=rows,
+            log.log_series(f"/completeness/{method}", t, schemas.Scalars, units="1", value=rows,
                            name=["solutions", "generating_found", "twin_found", "roots", "real_roots",
                                  "rejected_roots", "c_generating"])
         n_ref = min(int(sc.reference_poses), len(q))
@@ -173,7 +177,7 @@ def completeness(cfg: DictConfig) -> list[Case]:
             ref_rows[k, 0] = len(ref)
             for m, method in enumerate(ik.METHODS):
                 ref_rows[k, 1 + 3 * m:4 + 3 * m] = peers.compare(solutions[method][k], ref, 1e-6)
-        log.log_series("/completeness/reference", t[:n_ref], schemas.Scalars, value=ref_rows,
+        log.log_series("/completeness/reference", t[:n_ref], schemas.Scalars, units="1", value=ref_rows,
                        name=["reference", *(f"{m}.{k}" for m in ik.METHODS
                                             for k in ("common", "ours_only", "reference_only"))])
 
@@ -213,7 +217,8 @@ def compute_time(cfg: DictConfig) -> list[Case]:
             theirs = [peer.convert(peer.call(x)) for (x,) in inputs]
             rows = np.array([(len(s), *peers.compare(a, s, peer.match_tol), *peers.compare(b, s, peer.match_tol))
                              for a, b, s in zip(ours[:n], octic[:n], theirs, strict=True)])
-            log.log_series(f"/peers/{peer.name}", np.arange(n) * 1e-3, schemas.Scalars, value=rows.astype(float),
+            log.log_series(f"/peers/{peer.name}", np.arange(n) * 1e-3, schemas.Scalars, units="1",
+                           value=rows.astype(float),
                            name=["solutions", *(f"{m}.{k}" for m in ik.METHODS
                                                 for k in ("common", "ours_only", "peer_only"))])
         log.metadata["peers"] = json.dumps(status)
@@ -223,10 +228,10 @@ def compute_time(cfg: DictConfig) -> list[Case]:
             log.log_series("/compute_time", times, name=[timing.name], calls=[timing.items_per_call],
                            seconds=timing.seconds[:, None])
             t = float(times[-1]) + 1e-3
-        log.log_series("/ik/solutions", np.arange(len(poses)) * 1e-3, schemas.Scalars,
+        log.log_series("/ik/solutions", np.arange(len(poses)) * 1e-3, schemas.Scalars, units="1",
                        name=["lambda16", "octic"],
                        value=np.column_stack([[len(o) for o in ours], [len(o) for o in octic]]).astype(float))
-        log.log_series("/ik/octic_vs_lambda16", np.arange(len(poses)) * 1e-3, schemas.Scalars,
+        log.log_series("/ik/octic_vs_lambda16", np.arange(len(poses)) * 1e-3, schemas.Scalars, units="1",
                        name=["common", "lambda16_only", "octic_only"],
                        value=np.array([peers.compare(a, b, tol.duplicate) for a, b in zip(ours, octic, strict=True)],
                                       dtype=float))
@@ -329,16 +334,19 @@ def trajectory(cfg: DictConfig) -> list[Case]:
         every = slice(None, None, max(1, round(ex.log_dt / dt)))
         t_state = (times + dt)[every]
         q, qd, tau = states[every, 1:7], states[every, 7:13], sensors[every, :6]
-        log.log_series("/reference", times[every], name=JOINTS, position=q_ref[every], velocity=qd_ref[every])
-        log.log_series("/joint_state", t_state, name=JOINTS, position=q, velocity=qd, effort=tau)
-        log.log_series("/command", t_state, kind="torque", name=JOINTS, value=tau)
+        log.log_series("/reference", times[every], units="rad", name=JOINTS, position=q_ref[every],
+                       velocity=qd_ref[every])
+        log.log_series("/joint_state", t_state, units="rad", name=JOINTS, position=q, velocity=qd, effort=tau)
+        log.log_series("/command", t_state, units="rad", kind="torque", name=JOINTS, value=tau)
         err = q_ref[every] - q
-        log.log_series("/tracking_error", t_state, name=JOINTS, error=err, norm=np.linalg.norm(err, axis=1))
+        log.log_series("/tracking_error", t_state, units="rad", name=JOINTS, error=err,
+                       norm=np.linalg.norm(err, axis=1))
         sample = np.minimum(np.searchsorted(ik_times, t_state), len(poses) - 1)
         T_act = fk(q, g)
         dp = poses[sample, :3, 3] - T_act[:, :3, 3]
         rot = rotation_angle(poses[sample, :3, :3], T_act[:, :3, :3])
-        log.log_series("/tracking_error/flange", t_state, name=["x", "y", "z", "rotation"],
+        log.log_series("/tracking_error/flange", t_state, units=["m", "m", "m", "rad"], field_units={"norm": "m"},
+                       name=["x", "y", "z", "rotation"],
                        error=np.column_stack([dp, rot]), norm=np.linalg.norm(dp, axis=1))
         tf = slice(None, None, max(1, round(ex.tf_dt / dt)))
         t_tf = (times + dt)[tf]

@@ -19,7 +19,7 @@ from pipeline.papers.curve_discretization import snake as sn
 
 CurvePoints = schemas.define(
     "CurvePoints", "Points of a space curve or of a chain's joints: curve parameter and position.",
-    name="string[]", parameter="double[]", x="double[]", y="double[]", z="double[]",
+    name="string[]", parameter="double[] 1", x="double[] m", y="double[] m", z="double[] m",
 )
 
 
@@ -78,8 +78,9 @@ def bezier_fig2(cfg: DictConfig) -> list[Case]:
                                         chain, printed)
         _log_points(log, "/chain/poe", poe[:, :3, 3], names)
         _log_points(log, "/chain/mujoco", dc.joint_positions(mujoco_points(chain, search, angles), chain.joints), names)
-        log.log("/joint_state", 0.0, name=names, position=angles.theta.tolist())
-        log.log("/chain/first_frame", 0.0, schemas.Scalars, name=["theta_z0", "theta_y0", "theta_x0", "evaluations"],
+        log.log("/joint_state", 0.0, units="rad", name=names, position=angles.theta.tolist())
+        log.log("/chain/first_frame", 0.0, schemas.Scalars, units=["rad", "rad", "rad", "1"],
+                name=["theta_z0", "theta_y0", "theta_x0", "evaluations"],
                 value=[angles.theta_z0, angles.theta_y0, theta_x0, search.evaluations])
         log.log_transforms(np.zeros(1), "world", names, frames[None])
 
@@ -129,7 +130,8 @@ def timing_fig3(cfg: DictConfig) -> list[Case]:
         search, chain = searches[joints], chains[joints]
         log_timings(log, [dataclasses.replace(timings[f"{stage}@{joints}"], name=stage)
                           for stage in ("search", "angles", "total")])
-        log.log("/chain/search", 0.0, schemas.Scalars, name=["joints", "segments", "segment_length", "evaluations"],
+        log.log("/chain/search", 0.0, schemas.Scalars, units=["1", "1", "m", "1"],
+                name=["joints", "segments", "segment_length", "evaluations"],
                 value=[joints, chain.segments, chain.segment_lengths[0], search.evaluations])
         _log_points(log, "/chain/curve", search.points, sn.point_names(chain), search.t)
 
@@ -175,20 +177,22 @@ def snake_gait(cfg: DictConfig) -> list[Case]:
 def log_gait(log: RunWriter, run: sn.GaitRun, chain: dc.Chain, xml: str, tf_dt: float) -> None:
     t = run.times
     joints, points = sn.joint_names(chain), sn.point_names(chain)
-    log.log_series("/reference", t, name=joints, position=run.q_ref, velocity=run.qd_ref)
-    log.log_series("/joint_state", t, name=joints, position=run.q, velocity=run.qd, effort=run.tau)
-    log.log_series("/command", t, kind="torque", name=joints, value=run.tau)
+    log.log_series("/reference", t, units="rad", name=joints, position=run.q_ref, velocity=run.qd_ref)
+    log.log_series("/joint_state", t, units="rad", name=joints, position=run.q, velocity=run.qd, effort=run.tau)
+    log.log_series("/command", t, units="rad", kind="torque", name=joints, value=run.tau)
     error = run.q_ref - run.q
-    log.log_series("/tracking_error", t, name=joints, error=error, norm=np.linalg.norm(error, axis=1))
+    log.log_series("/tracking_error", t, units="rad", name=joints, error=error, norm=np.linalg.norm(error, axis=1))
     # shape: each joint point of the body against the curve's, the curve placed on the body by the best rigid fit
     placed, distance = sn.shape_fit(run.body, run.target)
-    log.log_series("/tracking_error/shape", t, name=points, error=distance, norm=np.linalg.norm(distance, axis=1))
+    log.log_series("/tracking_error/shape", t, units="m", name=points, error=distance,
+                   norm=np.linalg.norm(distance, axis=1))
     log.log_series("/compute_time", t, name=list(run.seconds), calls=[1] * len(run.seconds),
                    seconds=np.column_stack(list(run.seconds.values())))
     comparison = run.warm_vs_cold  # steps 1 … K−1, each logged at the instant of its curve
     log.log_series("/compute_time", t[1:], name=[x.name for x in comparison.timings], calls=[1, 1],
                    seconds=np.column_stack([x.seconds for x in comparison.timings]))
-    log.log_series("/search", t[1:], schemas.Scalars, name=["evaluations_warm", "evaluations_cold", "warm_cold_gap"],
+    log.log_series("/search", t[1:], schemas.Scalars, units=["1", "1", "1"],  # the gap is in curve parameter
+                   name=["evaluations_warm", "evaluations_cold", "warm_cold_gap"],
                    value=np.column_stack([*comparison.evaluations.values(), comparison.gap]))
     every = slice(None, None, max(1, round(tf_dt / (t[1] - t[0]))))
     frames, body = sn.segment_frames(xml, run.qpos[every], chain)

@@ -4,6 +4,7 @@ the analysis needs to rebuild the paper's numbers; lengths in m, angles in rad."
 
 from __future__ import annotations
 
+import fnmatch
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -36,14 +37,14 @@ from pipeline.papers.dyad_triad_synthesis.standard_form import dyad, link_vector
 
 Vectors = schemas.define(
     "PlanarVectors", "Named planar vectors (complex numbers) in metres: x and y components.",
-    name="string[]", x="double[]", y="double[]",
+    name="string[]", x="double[] m", y="double[] m",
 )
 SynthesisRoot = schemas.define(
     "SynthesisRoot", "One real root of the compatibility equations: its rotations β (rad, positions 1..n), the "
     "closing assembly, what it is (trivial | special | degenerate | solution), the link vectors it gives (x, y "
     "in m, named W, Z for a dyad, W, V, Z for a triad), the residual of the linear solve (m) and its conditioning.",
-    label="string", branch="int64", beta="double[]", name="string[]", x="double[]", y="double[]",
-    residual="double", conditioning="double",
+    label="string", branch="int64 1", beta="double[] rad", name="string[]", x="double[] m", y="double[] m",
+    residual="double m", conditioning="double 1",
 )
 DYAD_LINKS = ["W", "Z"]
 
@@ -80,8 +81,17 @@ def log_roots(log: RunWriter, topic: str, found: list[Synthesized], links: list[
                 conditioning=f.conditioning)
 
 
-def log_scalars(log: RunWriter, topic: str, t: float, values: dict[str, float]) -> None:
-    log.log(topic, t, schemas.Scalars, name=list(values), value=[float(v) for v in values.values()])
+def units_of(names, patterns: dict[str, str] | str = "1") -> list[str]:
+    """Each name's unit: the first glob pattern it matches (`*.x` -> m), else a pure number."""
+    if isinstance(patterns, str):
+        return [patterns] * len(names)
+    return [next((u for pattern, u in patterns.items() if fnmatch.fnmatchcase(n, pattern)), "1") for n in names]
+
+
+def log_scalars(log: RunWriter, topic: str, t: float, values: dict[str, float],
+                units: dict[str, str] | str = "1") -> None:
+    log.log(topic, t, schemas.Scalars, units=units_of(values, units), name=list(values),
+            value=[float(v) for v in values.values()])
 
 
 def paper_four_bar(cfg: DictConfig) -> tuple[FourBar, list[dict[str, float]], np.ndarray, np.ndarray]:
@@ -122,13 +132,14 @@ def table5(cfg: DictConfig) -> list[Case]:
                                                                                              strict=True)}
         ranges |= {f"both.{i}.{end}": v for i, arc in enumerate(intersect(*loop_ranges))
                    for end, v in zip(("lo", "hi"), arc, strict=True)}
-        log_scalars(log, "/synthesis/beta2_range", 0.0, ranges)
+        log_scalars(log, "/synthesis/beta2_range", 0.0, ranges, "rad")
         # the compatibility sweep: loop 2's closure residual [m] on both assemblies of loop 1 (Fig. 12-13)
         compat = Compatibility(chain)
         beta2 = np.linspace(-math.pi, math.pi, sc.sweep_samples)
         columns = [compat.evaluate(beta2[:, None], b) for b in BRANCHES]
+        names = ["beta2", *(f"{k}.branch{b:+d}" for b in BRANCHES for k in ("residual", "beta3", "beta4"))]
         log.log_series("/synthesis/sweep", np.arange(len(beta2)) * 1e-3, schemas.Scalars,
-                       name=["beta2", *(f"{k}.branch{b:+d}" for b in BRANCHES for k in ("residual", "beta3", "beta4"))],
+                       units=units_of(names, {"residual.*": "m", "beta*": "rad"}), name=names,
                        value=np.column_stack([beta2, *(np.column_stack([r[:, 0], beta[:, 2], beta[:, 3]])
                                                        for beta, r in columns)]))
         # independent check: the Burmester circle-point condition by least squares (no cofactors)
@@ -180,7 +191,9 @@ def burmester_curves(cfg: DictConfig) -> list[Case]:
                         beta[:, 2], beta[:, 3]]
         names = [f"{k}.branch{b:+d}" for b in BRANCHES for k in ("center.x", "center.y", "circle.x", "circle.y",
                                                                    "conditioning", "beta3", "beta4")]
-        log.log_series("/burmester/curves", np.arange(len(beta2)) * 1e-3, schemas.Scalars, name=["beta2", *names],
+        log.log_series("/burmester/curves", np.arange(len(beta2)) * 1e-3, schemas.Scalars,
+                       units=units_of(["beta2", *names], {"beta*": "rad", "center.*": "m", "circle.*": "m"}),
+                       name=["beta2", *names],
                        value=np.column_stack([beta2, *columns]))
         log_vectors(log, "/burmester/poles", 0.0, burmester.poles(points, alpha))
         log_vectors(log, "/burmester/image_poles", 0.0, burmester.image_poles(points, alpha))
@@ -190,7 +203,7 @@ def burmester_curves(cfg: DictConfig) -> list[Case]:
         log_vectors(log, "/burmester/image_pi_points", 0.0,
                     burmester.pi_points(points, alpha, burmester.PI_IMAGE_LINES))
         log_vectors(log, "/burmester/positions", 0.0, {f"P{j + 1}": p for j, p in enumerate(points)})
-        log_scalars(log, "/burmester/alpha", 0.0, {f"alpha{j + 1}": a for j, a in enumerate(alpha)})
+        log_scalars(log, "/burmester/alpha", 0.0, {f"alpha{j + 1}": a for j, a in enumerate(alpha)}, "rad")
 
     return [Case("table4-" + "".join(map(str, cfg.scenario.positions)), simulate)]
 
@@ -257,7 +270,7 @@ def round_trips(cfg: DictConfig) -> list[Case]:
                 "dyad4.error_A": errors4[0], "dyad4.error_B": errors4[1],
                 "dyad4.center_condition_A": curve[0], "dyad4.circle_condition_A": curve[1],
                 "dyad4.center_condition_B": curve[2], "dyad4.circle_condition_B": curve[3],
-                "scale": max(abs(wa), abs(za), abs(wb), abs(zb))})
+                "scale": max(abs(wa), abs(za), abs(wb), abs(zb))}, {"*.error_*": "m", "scale": "m"})
 
     def triads(log: RunWriter, n: int) -> None:
         rng = np.random.default_rng(cfg.seed + n)
@@ -281,7 +294,8 @@ def round_trips(cfg: DictConfig) -> list[Case]:
                 grid = [f.beta for f in found]
                 missed = sum(all(_angle_error(r.beta, g) > 1e-6 for g in grid) for r in from_newton)
                 values |= {"newton_roots": len(from_newton), "missed_by_grid": missed}
-            log_scalars(log, "/round_trip", float(k), values)
+            log_scalars(log, "/round_trip", float(k), values, {"beta_error": "rad", "vector_error": "m",
+                                                              "compatibility_residual": "m", "scale": "m"})
 
     def solution_counts(log: RunWriter) -> None:
         """Random five-position problems: real dyads (0, 2 or 4, Table 1) and complex roots (six, Sec. 2.3)."""
@@ -327,7 +341,8 @@ def _defects(log: RunWriter, fb: FourBar, poses: list[dict[str, float]]) -> None
                        f"{driver}.leg{j}{j + 1}.transmission.max": float(mu.max()),
                        f"{driver}.leg{j}{j + 1}.coupler_monotonic": float(np.all(np.diff(s["coupler"]) > 0)
                                                                           or np.all(np.diff(s["coupler"]) < 0))}
-    log_scalars(log, "/defects", 0.0, values)
+    log_scalars(log, "/defects", 0.0, values, {"grashof_margin": "m", "length.*": "m", "*.range.*": "rad",
+                                               "*.path_length": "m", "*.transmission.*": "rad"})
 
 
 def _quintic(s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -387,13 +402,13 @@ def _log_motion(log: RunWriter, cfg: DictConfig, model: multibody.ExudynFourBar,
     dt = float(np.median(np.diff(t)))
     every = slice(None, None, max(1, round(ex.log_dt / dt)))
     ts, qs, qds = t[every], q[every], qd[every]
-    log.log_series("/joint_state", ts, name=list(LINKS), position=qs[:, :, 2], velocity=qds[:, :, 2])
+    log.log_series("/joint_state", ts, units="rad", name=list(LINKS), position=qs[:, :, 2], velocity=qds[:, :, 2])
     names = reference["name"]
-    log.log_series("/reference", ts, name=list(names), position=reference["position"][every],
+    log.log_series("/reference", ts, units="rad", name=list(names), position=reference["position"][every],
                    velocity=reference["velocity"][every], acceleration=reference["acceleration"][every])
     driven = np.where(driver_of[every] == "A", qs[:, 0, 2], qs[:, 2, 2])
     err = reference["position"][every][:, 0] - driven
-    log.log_series("/tracking_error", ts, name=["driver"], error=err[:, None], norm=np.abs(err))
+    log.log_series("/tracking_error", ts, units="rad", name=["driver"], error=err[:, None], norm=np.abs(err))
     # the tracer and coupler against the closed-form analysis at the same driver rotation and branch
     tracer = multibody.points_of(model.bodies, qs, 1, model.fourbar.p)
     closed = np.empty(len(ts), dtype=complex)
@@ -406,10 +421,11 @@ def _log_motion(log: RunWriter, cfg: DictConfig, model: multibody.ExudynFourBar,
                 closed[sel], coupler[sel] = c["p"], c["coupler"]
     dp = tracer - closed
     da = np.remainder(qs[:, 1, 2] - coupler + math.pi, 2 * math.pi) - math.pi
-    log.log_series("/tracking_error/closed_form", ts, name=["x", "y", "coupler"],
+    log.log_series("/tracking_error/closed_form", ts, units=["m", "m", "rad"], field_units={"norm": "m"},
+                   name=["x", "y", "coupler"],
                    error=np.column_stack([dp.real, dp.imag, da]), norm=np.abs(dp))
     gaps = multibody.joint_gaps(model, qs)
-    log.log_series("/joint_gap", ts, schemas.Scalars, name=["a0", "a1", "b1", "b0"], value=gaps)
+    log.log_series("/joint_gap", ts, schemas.Scalars, units="m", name=["a0", "a1", "b1", "b0"], value=gaps)
     tf = slice(None, None, max(1, round(ex.tf_dt / dt)))
     log.log_transforms(t[tf], "world", FRAMES, _frames(model, q[tf]))
     log.attach("model.xml", mujoco_model.model_xml(model.fourbar, model.bodies, cfg.system.linkage.link_radius),
@@ -434,7 +450,8 @@ def _arrivals(log: RunWriter, model: multibody.ExudynFourBar, t: np.ndarray, q: 
             "target.alpha": alpha[j - 1], "sim.x": p.real, "sim.y": p.imag, "sim.alpha": qk[0, 1, 2],
             "closed_form.x": complex(c["p"]).real, "closed_form.y": complex(c["p"]).imag,
             "closed_form.alpha": float(c["coupler"]), "driver_rotation": rotation,
-            "joint_gap": float(multibody.joint_gaps(model, qk).max())})
+            "joint_gap": float(multibody.joint_gaps(model, qk).max())},
+            {"*.x": "m", "*.y": "m", "*.alpha": "rad", "driver_rotation": "rad", "joint_gap": "m"})
 
 
 def four_bar(cfg: DictConfig) -> list[Case]:
@@ -450,7 +467,7 @@ def four_bar(cfg: DictConfig) -> list[Case]:
         for b in BRANCHES:
             c = fb.solve("B", x if b == 1 else x[::-1], b)
             rows.append(np.column_stack([c["p"].real, c["p"].imag, c["crank_A"], c["coupler"], c["rocker_B"]]))
-        log.log_series("/circuit", np.arange(2 * len(x)) * 1e-3, schemas.Scalars,
+        log.log_series("/circuit", np.arange(2 * len(x)) * 1e-3, schemas.Scalars, units=["m", "m", "rad", "rad", "rad"],
                        name=["tracer.x", "tracer.y", *LINKS], value=np.concatenate(rows))
 
     def replay(log: RunWriter) -> None:
@@ -557,14 +574,15 @@ def log_servo(log: RunWriter, cfg: DictConfig, run: ServoRun, points: np.ndarray
     t, q = run.t, run.q
     _log_motion(log, cfg, run.model, t, q, run.qd, run.reference, np.full(len(t), "B"), np.full(len(t), run.branch),
                 points)
-    log.log_series("/command", np.arange(len(run.torque)) * cfg.execute.control_dt, kind="torque",
+    log.log_series("/command", np.arange(len(run.torque)) * cfg.execute.control_dt, units="rad", kind="torque",
                    name=["rocker_B"], value=run.torque[:, None])
     tracer = multibody.points_of(run.model.bodies, q, 1, run.model.fourbar.p)
     for j in range(2, len(points) + 1):
         k = int(np.argmin(np.abs(tracer - points[j - 1])))
         log_scalars(log, "/passage", float(t[k]), {
             "position": j, "distance": abs(tracer[k] - points[j - 1]),
-            "coupler_error": math.remainder(q[k, 1, 2] - alpha[j - 1], 2 * math.pi)})
+            "coupler_error": math.remainder(q[k, 1, 2] - alpha[j - 1], 2 * math.pi)},
+            {"distance": "m", "coupler_error": "rad"})
 
 
 # -- compute-time ------------------------------------------------------------------------------------------

@@ -38,14 +38,23 @@ Balance = schemas.define(
     "CoP of all contact forces (m; z = 0 on the ground, NaN without contact), commanded ZMP p^c of eq. (50) after "
     "the clamp (m; z: the virtual eZMP height), support (0 both feet, 1 left, 2 right), DAQP exit flag of the "
     "wrench QP (1 = optimal; NaN: no QP) and its iterations, and the measured sole centres (m). `name` labels x, y, z.",
-    name="string[]", com="double[]", com_vel="double[]", cp="double[]", zmp="double[]", zmp_cmd="double[]",
-    support="double", qp_flag="double", qp_iterations="double", left_sole="double[]", right_sole="double[]",
+    name="string[]", com="double[] m", com_vel="double[] m/s", cp="double[] m", zmp="double[] m",
+    zmp_cmd="double[] m", support="double 1", qp_flag="double 1", qp_iterations="double 1", left_sole="double[] m",
+    right_sole="double[] m",
 )
 Curve = schemas.define(
     "ForrestCurve", "One sample of a curve over a joint angle or a grid of two (log time = sample index in ms): "
     "`name` labels `value`, each name ending in its unit.",
-    name="string[]", value="double[]",
+    name="string[]", value="double[] q",
 )
+# a Curve's names end in their unit: name suffix -> unit (the longest suffixes first)
+SUFFIX_UNITS = {"_Nm_per_rad": "N*m/rad", "_m_per_rad": "m/rad", "_rad_s": "rad/s", "_m_s": "m/s", "_Nm": "N*m",
+                "_rad": "rad", "_kg": "kg", "_J": "J", "_m": "m"}
+
+
+def suffix_units(names) -> list[str]:
+    """The unit each name ends in (`torque_Nm` -> N*m)."""
+    return [next(u for suffix, u in SUFFIX_UNITS.items() if n.endswith(suffix)) for n in names]
 
 
 def system_dict(cfg: DictConfig) -> dict:
@@ -72,15 +81,15 @@ def log_pattern(log: RunWriter, p: gen.Pattern, n: int | None = None) -> None:
     """The references on /reference/* (the first n cycles)."""
     n = len(p.t) if n is None else n
     t = p.t[:n]
-    log.log_series("/reference/com", t, name=XYZ, position=p.com[:n], velocity=p.com_vel[:n],
+    log.log_series("/reference/com", t, units="m", name=XYZ, position=p.com[:n], velocity=p.com_vel[:n],
                    acceleration=p.com_acc[:n])
-    log.log_series("/reference/cp", t, name=XYZ, position=p.cp[:n])
-    log.log_series("/reference/zmp", t, name=XYZ, position=p.zmp[:n])
+    log.log_series("/reference/cp", t, units="m", name=XYZ, position=p.cp[:n])
+    log.log_series("/reference/zmp", t, units="m", name=XYZ, position=p.zmp[:n])
     feet = [f"{side}.{a}" for side in ("left", "right") for a in XYZ]
-    log.log_series("/reference/feet", t, name=feet, position=p.feet[:, :n].transpose(1, 0, 2).reshape(n, 6),
+    log.log_series("/reference/feet", t, units="m", name=feet, position=p.feet[:, :n].transpose(1, 0, 2).reshape(n, 6),
                    velocity=p.feet_vel[:, :n].transpose(1, 0, 2).reshape(n, 6),
                    acceleration=p.feet_acc[:, :n].transpose(1, 0, 2).reshape(n, 6))
-    log.log_series("/pattern/support", t, schemas.Scalars, name=["support"], value=p.support[:n, None] * 1.0)
+    log.log_series("/pattern/support", t, schemas.Scalars, units="1", name=["support"], value=p.support[:n, None] * 1.0)
 
 
 def log_steps(log: RunWriter, p: gen.Pattern) -> None:
@@ -95,20 +104,20 @@ def log_steps(log: RunWriter, p: gen.Pattern) -> None:
         end = round((t0 + s.T) / (p.t[1] - p.t[0]))
         miss = (p.cp[end] - s.P2[i]) if end < len(p.t) else np.full(3, np.nan)
         rows.append(np.concatenate([s.P0[i], P1, s.P2[i], miss]))
-    log.log_series("/pattern/steps", s.t0, schemas.Scalars, name=names, value=np.array(rows))
+    log.log_series("/pattern/steps", s.t0, schemas.Scalars, units="m", name=names, value=np.array(rows))
 
 
 def log_errors(log: RunWriter, t: np.ndarray, p: gen.Pattern, com: np.ndarray, cp: np.ndarray) -> None:
     n = len(t)
     for topic, err in (("/tracking_error", p.com[:n] - com), ("/tracking_error/cp", p.cp[:n] - cp)):
-        log.log_series(topic, t, name=XYZ, error=err, norm=np.linalg.norm(err, axis=1))
+        log.log_series(topic, t, units="m", name=XYZ, error=err, norm=np.linalg.norm(err, axis=1))
 
 
 def log_walk(log: RunWriter, p: gen.Pattern, w: walking.WalkLog, biped, tf_every: int) -> None:
     t, n = w.t, len(w.t)
     log_pattern(log, p, n)
-    log.log_series("/joint_state", t, name=list(JOINTS), position=w.q, velocity=w.qd, effort=w.tau)
-    log.log_series("/command", t, kind="torque", name=list(JOINTS), value=w.tau)
+    log.log_series("/joint_state", t, units="rad", name=list(JOINTS), position=w.q, velocity=w.qd, effort=w.tau)
+    log.log_series("/command", t, units="rad", kind="torque", name=list(JOINTS), value=w.tau)
     zmp = np.column_stack([w.zmp, np.where(np.isnan(w.zmp[:, 0]), np.nan, 0.0)])
     log.log_series("/balance", t, Balance, name=XYZ, com=w.com, com_vel=w.com_vel, cp=w.cp, zmp=zmp,
                    zmp_cmd=w.zmp_cmd, support=p.support[:n] * 1.0, qp_flag=w.qp_flag * 1.0,
@@ -118,7 +127,8 @@ def log_walk(log: RunWriter, p: gen.Pattern, w: walking.WalkLog, biped, tf_every
     # diverged state to the watchdog)
     contact = np.isfinite(w.zmp[:, 0])
     zerr = w.zmp_cmd[contact, :2] - w.zmp[contact]
-    log.log_series("/tracking_error/zmp", t[contact], name=XYZ[:2], error=zerr, norm=np.linalg.norm(zerr, axis=1))
+    log.log_series("/tracking_error/zmp", t[contact], units="m", name=XYZ[:2], error=zerr,
+                   norm=np.linalg.norm(zerr, axis=1))
     both = ["measured", "commanded"]
     for f, side in enumerate(("left_foot", "right_foot")):
         pair = np.stack([w.wrench[:, f], w.wrench_cmd[:, f]], axis=1)         # (n, 2, 6)
@@ -183,7 +193,7 @@ def mechanism_curves(cfg: DictConfig) -> list[Case]:
         cols = {"flexion_rad": theta, "arm_m": k["h"], "J_AB_m_per_rad": k["J_AB"], "speed_rad_s": k["speed"],
                 "torque_Nm": k["torque"], "stiffness_Nm_per_rad": k["stiffness"], "q19_rad": q19, "q20_rad": q20,
                 "screw_length_m": mechanisms.knee_screw_length(knee, theta)}
-        log.log_series("/knee", np.arange(len(theta)) * 1e-3, Curve, name=list(cols),
+        log.log_series("/knee", np.arange(len(theta)) * 1e-3, Curve, units=suffix_units(cols), name=list(cols),
                        value=np.column_stack(list(cols.values())))
         ankle = mechanisms.Ankle.from_config(s.ankle)
         g11, g12 = np.meshgrid(np.linspace(*sc.ankle_q11, sc.ankle_samples),
@@ -196,7 +206,7 @@ def mechanism_curves(cfg: DictConfig) -> list[Case]:
         cols = {"q11_rad": q11, "q12_rad": q12, "q25_m": sliders[:, 0], "q28_m": sliders[:, 1],
                 "rod_error_m": np.abs(np.linalg.norm(B - A, axis=-1) - ankle.rod).max(axis=1),
                 **{f"{name}_{units[name.split('_')[0]]}": v for name, v in a.items()}}
-        log.log_series("/ankle", np.arange(len(q11)) * 1e-3, Curve, name=list(cols),
+        log.log_series("/ankle", np.arange(len(q11)) * 1e-3, Curve, units=suffix_units(cols), name=list(cols),
                        value=np.column_stack(list(cols.values())))
         e_knee = mechanisms.spring_energy(s.knee.spring, s.knee.spring_max_force)
         claims = {"knee_spring_energy_J": e_knee,
@@ -207,7 +217,7 @@ def mechanism_curves(cfg: DictConfig) -> list[Case]:
                   "table1_mass_kg": float(np.sum(s.table1.mass[:1]) + 2 * np.sum(s.table1.mass[1:])),
                   "table1_height_m": float(np.sum(s.table1.height)),
                   "table4_mass_kg": build(system_dict(cfg), plant=False).mass}
-        log.log("/claims", 0.0, Curve, name=list(claims), value=list(claims.values()))
+        log.log("/claims", 0.0, Curve, units=suffix_units(claims), name=list(claims), value=list(claims.values()))
 
     return [Case("knee-ankle", simulate)]
 

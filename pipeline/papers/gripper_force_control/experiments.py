@@ -29,11 +29,20 @@ PLANTS = ("mujoco", "lumped")
 
 TableRow = schemas.define(
     "GripperTableRow", "One row of a comparison table of the gripper paper (datasheet values as printed).",
-    table="string", gripper="string", name="string[]", value="double[]",
+    table="string", gripper="string", name="string[]", value="double[] q",
 )
+# the units of the tables' columns (and of the Sect. 5 text's rows), as the paper prints them
+TABLE_UNITS = {"peak_force": "N", "flange_mass": "kg", "frame_mass": "kg", "total_mass": "kg", "finger_speed": "m/s",
+               "printed_ratio": "1", "max_force_error": "N", "time_min": "s", "time_max": "s", "travel": "m",
+               "min_force": "N", "damage_force_min": "N", "safety_factor": "1", "force_error": "N",
+               "open_close_time": "s", "lift_rotate_time": "s", "cycle_time": "s", "rate": "1/min"}
+MODEL_UNITS = {"l_a": "m", "h_g": "m", "force_per_amp": "N/A", "K_eps": "A/(rad/s^2)", "K_omega": "V/(rad/s)",
+               "K_eps_printed": "A/(rad/s^2)", "K_omega_printed": "V/(rad/s)", "current_pole": "1/s",
+               "current_zero": "1/s", "current_bandwidth": "1/s", "velocity_crossover": "rad/s",
+               "position_bandwidth": "1/s", "move_40deg": "s", "move_45deg": "s", "voltage_limited_finger_speed": "m/s"}
 GraspSample = schemas.define(
     "GripperGraspSample", "The random draws of Monte-Carlo grasps: approach gap (m) and M1 Coulomb friction (N m).",
-    name="string[]", force_set="double[]", gap="double[]", m1_coulomb="double[]",
+    name="string[]", force_set="double[] N", gap="double[] m", m1_coulomb="double[] N*m",
 )
 
 
@@ -90,16 +99,16 @@ def log_trace(log: RunWriter, p: Gripper, s: Schedule, trace: Trace, log_every: 
     velocity = np.column_stack([trace["omega_1"], -g.g_c * omega_g, omega_g, trace["omega_f"]])
     effort = np.column_stack([p.K_t * trace["I_1"], -p.K_t * trace["I_2"], g.g_c * p.K_t * trace["I_2"],
                               trace["force"] * p.l_f])   # motor torques; M2's at the gripper; the fingers' load
-    log.log_series("/joint_state", t, name=JOINTS, position=position, velocity=velocity, effort=effort)
+    log.log_series("/joint_state", t, units="rad", name=JOINTS, position=position, velocity=velocity, effort=effort)
     phi_sr = s.phi_sr[::log_every]
-    log.log_series("/reference", t, name=["gripper"], position=phi_sr[:, None],
+    log.log_series("/reference", t, units="rad", name=["gripper"], position=phi_sr[:, None],
                    velocity=s.omega_sr[::log_every, None], acceleration=s.epsilon_sr[::log_every, None])
     log.log_series("/command", t, kind="voltage", name=["m1", "m2"],
                    value=np.column_stack([trace["U_1"], trace["U_2"]]))
-    log.log_series("/drive/current", t, schemas.Scalars, name=["i_ref_m1", "i_m1", "i_ref_m2", "i_m2"],
+    log.log_series("/drive/current", t, schemas.Scalars, units="A", name=["i_ref_m1", "i_m1", "i_ref_m2", "i_m2"],
                    value=np.column_stack([trace["I_ref_1"], trace["I_1"], trace["I_ref_2"], trace["I_2"]]))
     error = phi_sr - phi_g
-    log.log_series("/tracking_error", t, name=["gripper"], error=error[:, None], norm=np.abs(error))
+    log.log_series("/tracking_error", t, units="rad", name=["gripper"], error=error[:, None], norm=np.abs(error))
 
 
 def _case_gripper(cfg: DictConfig, friction: bool, feedforward: bool = True, **system_overrides) -> Gripper:
@@ -204,8 +213,10 @@ def tables(cfg: DictConfig) -> list[Case]:
         for table, rows in sc.tables.items():
             columns = list(rows.columns)
             for gripper_name, values in rows.rows.items():
-                log.log("/tables", t, TableRow, table=table, gripper=gripper_name, name=columns,
-                        value=[float(v) for v in values])
+                # a column holds one quantity; the text's one `value` column holds one per row: named by its row
+                names = [gripper_name] if columns == ["value"] else columns
+                log.log("/tables", t, TableRow, units=[TABLE_UNITS.get(c, "") for c in names], table=table,
+                        gripper=gripper_name, name=names, value=[float(v) for v in values])
                 t += 1e-3   # one row per millisecond: a table is a sequence of records, not a trajectory
         p = gripper(cfg.system)
         printed_ff = gripper(OmegaConf.merge(cfg.system, {"controller": {"feedforward": "printed"}}))
@@ -221,6 +232,7 @@ def tables(cfg: DictConfig) -> list[Case]:
             "move_45deg": move_duration(np.deg2rad(45), p.omega_max, p.epsilon_max),
             "voltage_limited_finger_speed": p.l_f * (p.U_max - p.R * p.lookup(sc.tomato_force)) / p.K_e / g.g_f,
         }
-        log.log("/model", 0.0, schemas.Scalars, name=list(constants), value=list(constants.values()))
+        log.log("/model", 0.0, schemas.Scalars, name=list(constants), value=list(constants.values()),
+                units=[MODEL_UNITS.get(name, "1") for name in constants])   # the rest are gear ratios
 
     return [Case("paper-data", simulate)]

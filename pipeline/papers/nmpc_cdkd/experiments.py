@@ -25,8 +25,8 @@ PLANNING_REPEATS = 20
 NmpcSolve = schemas.define(
     "NmpcSolve", "One OCP solve of an NMPC: wall time, CasADi's own total, IPOPT iterations, status and cost; "
     "the move it belongs to and whether it is in the timing statistic (a probe's first solve is not).",
-    model="string", seconds="double", solver_seconds="double", iterations="uint32", success="bool",
-    status="string", cost="double", move="uint32", timed="bool",
+    model="string", seconds="double s", solver_seconds="double s", iterations="uint32 1", success="bool",
+    status="string", cost="double 1", move="uint32 1", timed="bool",
 )
 
 
@@ -113,18 +113,18 @@ def log_trajectory(log: RunWriter, arm: Arm, tr: Trajectory, model: str, obstacl
     run; the first `untimed` solves are left out of the timing statistic."""
     t = tr.t + offset
     efforts = {"effort": tr.effort} if np.isfinite(tr.effort).all() else {}  # a kinematic plant has none
-    log.log_series("/joint_state", t, name=JOINTS, position=tr.q, velocity=tr.qd, **efforts)
-    log.log_series("/command", t, kind="position", name=JOINTS, value=tr.q_cmd)
-    log.log_series("/command/velocity", t, kind="velocity", name=JOINTS, value=tr.qd_cmd)
-    log.log_series("/reference", t, name=JOINTS, position=tr.q_ref, velocity=tr.qd_ref)
+    log.log_series("/joint_state", t, units="rad", name=JOINTS, position=tr.q, velocity=tr.qd, **efforts)
+    log.log_series("/command", t, units="rad", kind="position", name=JOINTS, value=tr.q_cmd)
+    log.log_series("/command/velocity", t, units="rad", kind="velocity", name=JOINTS, value=tr.qd_cmd)
+    log.log_series("/reference", t, units="rad", name=JOINTS, position=tr.q_ref, velocity=tr.qd_ref)
     F, F_ref = kin.frames(arm, tr.q), kin.frames(arm, tr.q_ref)
     tip, tip_ref = (F @ arm.tool)[:, -1, :3, 3], (F_ref @ arm.tool)[:, -1, :3, 3]
     wrist, wrist_ref = F[:, 4, :3, 3], F_ref[:, 4, :3, 3]
-    log.log_series("/reference/tool", t, name=XYZ, position=tip_ref)
-    log.log_series("/reference/wrist", t, name=XYZ, position=wrist_ref)
-    for topic, err in (("/tracking_error", tip_ref - tip), ("/tracking_error/wrist", wrist_ref - wrist),
-                       ("/tracking_error/orientation", tr.orientation_error)):
-        log.log_series(topic, t, name=XYZ, error=err, norm=np.linalg.norm(err, axis=1))
+    log.log_series("/reference/tool", t, units="m", name=XYZ, position=tip_ref)
+    log.log_series("/reference/wrist", t, units="m", name=XYZ, position=wrist_ref)
+    for topic, err, unit in (("/tracking_error", tip_ref - tip, "m"), ("/tracking_error/wrist", wrist_ref - wrist, "m"),
+                             ("/tracking_error/orientation", tr.orientation_error, "rad")):
+        log.log_series(topic, t, units=unit, name=XYZ, error=err, norm=np.linalg.norm(err, axis=1))
     seconds = np.array([s.seconds for s in tr.solves])
     timed = np.arange(len(seconds)) >= untimed
     log.log_series("/compute_time", tr.solve_t[timed] + offset, name=[model], calls=[1],
@@ -136,7 +136,8 @@ def log_trajectory(log: RunWriter, arm: Arm, tr: Trajectory, model: str, obstacl
                    status=np.array([s.status for s in tr.solves]), cost=np.array([s.cost for s in tr.solves]),
                    move=np.full(len(seconds), move), timed=timed)
     sel = tr.selection
-    log.log("/planning", float(t[0]), schemas.Scalars, name=["seconds", "margin", "candidates", "jump_free"],
+    log.log("/planning", float(t[0]), schemas.Scalars, units=["s", "rad", "1", "1"],
+            name=["seconds", "margin", "candidates", "jump_free"],
             value=[tr.planning_seconds, sel.margin, sel.candidates, sel.jump_free])
     frames = [F[:, i] for i in range(1, 7)] + [F[:, 6] @ arm.tool]
     children = [f"link{i}" for i in range(1, 7)] + ["tool"]
@@ -150,8 +151,8 @@ def log_trajectory(log: RunWriter, arm: Arm, tr: Trajectory, model: str, obstacl
         if tr.tool_distance is not None:
             columns.append(tr.tool_distance)
             labels += [f"mujoco.{n}" for n in names]
-        log.log_series("/clearance", t, schemas.Scalars, name=labels, value=np.concatenate(columns, axis=1))
-        log.log_series("/obstacles", t, schemas.Scalars, name=[f"{n}.{a}" for n in names for a in XYZ],
+        log.log_series("/clearance", t, schemas.Scalars, units="m", name=labels, value=np.concatenate(columns, axis=1))
+        log.log_series("/obstacles", t, schemas.Scalars, units="m", name=[f"{n}.{a}" for n in names for a in XYZ],
                        value=centres.reshape(len(t), -1))
         poses = np.tile(np.eye(4), (len(t), len(names), 1, 1))
         poses[..., :3, 3] = centres

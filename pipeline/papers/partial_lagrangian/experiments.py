@@ -40,6 +40,11 @@ def _run(cfg: DictConfig, chain: ch.Chain, q0, gains: Gains, duration: float, li
     return traj
 
 
+def joint_units(chain: ch.Chain) -> list[str]:
+    """rad for a revolute joint's coordinate, m for a prismatic one's (the slider's length)."""
+    return ["rad" if kind == ch.REVOLUTE else "m" for kind in chain.joints]
+
+
 def every(cfg: DictConfig, period: float) -> slice:
     """Every sample `period` s apart, of a series stepped at the simulation's dt."""
     return slice(None, None, max(1, round(period / cfg.system.simulation.dt)))
@@ -50,20 +55,21 @@ def log_trajectory(log: RunWriter, cfg: DictConfig, chain: ch.Chain, traj: Traje
     every `logging.tf_dt`: the link tips as frames."""
     every_log = every(cfg, cfg.system.logging.log_dt)
     t, q, qd, tau = traj.t[every_log], traj.q[every_log], traj.qd[every_log], traj.tau[every_log]
-    names = chain.joint_names()
-    log.log_series("/joint_state", t, name=names, position=q, velocity=qd, effort=tau)
-    log.log_series("/command", t, kind="torque/force", name=names, value=tau)
+    names, units = chain.joint_names(), joint_units(chain)
+    log.log_series("/joint_state", t, units=units, name=names, position=q, velocity=qd, effort=tau)
+    log.log_series("/command", t, units=units, kind="torque/force", name=names, value=tau)
     e = ch.energies(chain, q, qd)
-    log.log_series("/energy", t, schemas.Scalars, name=ENERGY_TERMS,
+    log.log_series("/energy", t, schemas.Scalars, name=ENERGY_TERMS, units=["J", "J", "J", "W", "W"],
                    value=np.column_stack([e["kinetic"], e["potential"], e["total"], 2 * e["rayleigh"],
                                           (tau * qd).sum(axis=1)]))
     if gains.controlled.any():
         idx = np.flatnonzero(gains.controlled)
-        controlled = [names[i] for i in idx]
+        controlled, units = [names[i] for i in idx], [units[i] for i in idx]
         ref = np.tile(gains.reference[idx], (len(t), 1))
-        log.log_series("/reference", t, name=controlled, position=ref)
+        log.log_series("/reference", t, units=units, name=controlled, position=ref)
         err = ref - q[:, idx]
-        log.log_series("/tracking_error", t, name=controlled, error=err, norm=np.linalg.norm(err, axis=1))
+        log.log_series("/tracking_error", t, units=units, name=controlled, error=err, norm=np.linalg.norm(err, axis=1),
+                       field_units={"norm": " & ".join(sorted(set(units)))})
     tf = every(cfg, cfg.system.logging.tf_dt)
     log.log_transforms(traj.t[tf], "world", [f"tip{i + 1}" for i in range(chain.n)],
                        ch.pose_matrices(chain, traj.q[tf]))
@@ -134,7 +140,7 @@ def random_states(rng: np.random.Generator, n: int, count: int) -> tuple[np.ndar
 LinkTermsRow = schemas.define(
     "PartialLagrangianTerms", "Terms of link i's expanded symbolic partial Lagrangian L_i and of its derivatives "
     "(k = 1..i): ∂L_i/∂θ_k, ∂L_i/∂θ̇_k, τ_ki = D_k L_i; and the wall time of counting them (s).",
-    link="int64", lagrangian="int64", d_angle="int64[]", d_rate="int64[]", tau="int64[]", seconds="double",
+    link="int64 1", lagrangian="int64 1", d_angle="int64[] 1", d_rate="int64[] 1", tau="int64[] 1", seconds="double s",
 )
 
 
@@ -212,7 +218,7 @@ def compute_time(cfg: DictConfig) -> list[Case]:
                            seconds=timing.seconds[:, None])
             t_log = times[-1] + 1e-3
         sizes = np.array(sizes, dtype=float)
-        log.log_series("/graph_size", sizes[:, 0], schemas.Scalars, value=sizes[:, 1:],
+        log.log_series("/graph_size", sizes[:, 0], schemas.Scalars, value=sizes[:, 1:], units="1",
                        name=["terms.full", "terms.partial", "terms.column", "inverse.full", "inverse.partial"])
 
     return [Case("chains", simulate_case)]
@@ -261,21 +267,23 @@ def checks(cfg: DictConfig) -> list[Case]:
                 M_c, b_c = ch.double_pendulum(chain, q[k], qd[k])
                 errors[k, 4] = max(relative(M2, M_c), relative(b2.ravel(), b_c))
         log.log_series("/check/random_states", np.arange(sc.states) * 1e-3, schemas.Scalars, name=CHECK_TERMS,
-                       value=errors)
+                       value=errors, units="1")   # relative errors
         log.attach("model.xml", mj.xml, "application/xml")
         # free damped motion from the paper's start (at rest, straight), both integrated by the same Euler step
         traj = simulate(chain, q0, np.zeros(chain.n), Gains.free(chain.n), dt, sc.trajectory_duration)
         q_mj, qd_mj = mj.rollout(q0, np.zeros(chain.n), len(traj.t) - 1)
         q_mj, qd_mj = np.vstack([q0, q_mj]), np.vstack([np.zeros(chain.n), qd_mj])
-        names, logged = chain.joint_names(), every(cfg, cfg.system.logging.log_dt)
-        log.log_series("/joint_state", traj.t[logged], name=names, position=traj.q[logged], velocity=traj.qd[logged])
-        log.log_series("/joint_state/mujoco", traj.t[logged], schemas.JointState, name=names, position=q_mj[logged],
-                       velocity=qd_mj[logged])
+        names, logged, units = chain.joint_names(), every(cfg, cfg.system.logging.log_dt), joint_units(chain)
+        log.log_series("/joint_state", traj.t[logged], units=units, name=names, position=traj.q[logged],
+                       velocity=traj.qd[logged])
+        log.log_series("/joint_state/mujoco", traj.t[logged], schemas.JointState, units=units, name=names,
+                       position=q_mj[logged], velocity=qd_mj[logged])
         log.log_robot(traj.t[logged], q_mj[logged])
         for integrator in sc.energy_integrators:
             free = simulate(chain.undamped(), q0, np.zeros(chain.n), Gains.free(chain.n), dt, sc.energy_duration,
                             integrator=integrator)
             e = ch.energies(chain.undamped(), free.q[logged], free.qd[logged])
-            log.log_series(f"/energy/{integrator}", free.t[logged], schemas.Scalars, name=["total"], value=e["total"])
+            log.log_series(f"/energy/{integrator}", free.t[logged], schemas.Scalars, name=["total"], value=e["total"],
+                           units="J")
 
     return [Case(key, lambda log, k=key, i=i: simulate_case(log, k, i)) for i, key in enumerate(chains)]

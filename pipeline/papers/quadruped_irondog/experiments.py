@@ -26,39 +26,47 @@ FEET_FIELDS = [f"{leg}.{a}" for leg in LEGS for a in XYZ]
 
 TableRow = schemas.define(
     "IronDogTableRow", "One row of a table printed in the paper, as printed (units in the column names).",
-    table="string", row="string", name="string[]", value="double[]",
+    table="string", row="string", name="string[]", value="double[] q",
 )
 Trunk = schemas.define(
     "IronDogTrunk", "The trunk (its IMU frame, at the centre of the hips) in the world: x, y, z (m); roll, pitch, "
     "yaw (rad, R = Rz(yaw) Ry(pitch) Rx(roll)); linear velocity vx, vy, vz (m/s).",
-    x="double", y="double", z="double", roll="double", pitch="double", yaw="double", vx="double", vy="double",
-    vz="double",
+    x="double m", y="double m", z="double m", roll="double rad", pitch="double rad", yaw="double rad",
+    vx="double m/s", vy="double m/s", vz="double m/s",
 )
 Feet = schemas.define(
     "IronDogFeet", "Foot positions (m) in each leg's frame (x lateral outward, y up, z forward, origin at the coxa "
-    "joint), from the measured joint angles.", name="string[]", position="double[]",
+    "joint), from the measured joint angles.", name="string[]", position="double[] m",
 )
 FeetInBody = schemas.define(
     "IronDogFeetInBody", "Foot positions (m) in the body frame (x forward, y left, z up, origin at the hips' centre).",
-    name="string[]", position="double[]",
+    name="string[]", position="double[] m",
 )
-Bench = schemas.define("IronDogBench", "The tilting bench's angles (rad).", pitch="double", roll="double")
+Bench = schemas.define("IronDogBench", "The tilting bench's angles (rad).", pitch="double rad", roll="double rad")
 Balance = schemas.define(
-    "IronDogBalance", "The body rotation (rad) the levelling PID commands through body IK.", roll="double",
-    pitch="double",
+    "IronDogBalance", "The body rotation (rad) the levelling PID commands through body IK.", roll="double rad",
+    pitch="double rad",
 )
 StaticTorque = schemas.define(
     "IronDogStaticTorque", "Hand statics of a standing pose: servo torque (N·m) per joint, at the commanded pose "
-    "and at the pose MuJoCo settled in.", name="string[]", commanded="double[]", settled="double[]",
+    "and at the pose MuJoCo settled in.", name="string[]", commanded="double[] N*m", settled="double[] N*m",
 )
 StaticLoad = schemas.define(
     "IronDogStaticLoad", "Hand statics of a standing pose: vertical load (N) per foot, at the commanded pose and at "
-    "the pose MuJoCo settled in.", name="string[]", commanded="double[]", settled="double[]",
+    "the pose MuJoCo settled in.", name="string[]", commanded="double[] N", settled="double[] N",
 )
 GaitTiming = schemas.define(
     "IronDogGaitTiming", "A trot run's timing (s): step cycle, swing, when the trot starts, when the steady window "
-    "starts.", cycle_time="double", swing_time="double", trot_start="double", steady_start="double",
+    "starts.", cycle_time="double s", swing_time="double s", trot_start="double s",
+    steady_start="double s",
 )
+# the paper's printed tables and numbers keep their units, which their names end in
+PRINTED_UNITS = {"_g": "g", "_kg": "kg", "_usd": "USD", "_mm": "mm", "_n": "N", "_mpa": "MPa"}
+
+
+def printed_units(names) -> list[str]:
+    """The unit each printed column's name ends in (`total_g` -> g); counts and ratios are pure numbers."""
+    return [next((u for suffix, u in PRINTED_UNITS.items() if n.endswith(suffix)), "1") for n in names]
 
 
 # -- config -> objects -----------------------------------------------------------------------------------------
@@ -106,27 +114,29 @@ def log_trace(log: RunWriter, plant: Plant, trace: Trace, cfg: DictConfig, q_ref
     """The common topics of a MuJoCo run. `q_ref` (N, 12) and `feet_ref` (N, 4, 3, leg frames) are the continuous
     references where they differ from the servo commands (the trot's Bezier between control instants)."""
     t, leg = trace.t, plant.robot.leg
-    log.log_series("/joint_state", t, name=JOINT_NAMES, position=trace.q, velocity=trace.qd, effort=trace.tau)
-    log.log_series("/command", t, kind="position", name=JOINT_NAMES, value=trace.q_cmd)
+    log.log_series("/joint_state", t, units="rad", name=JOINT_NAMES, position=trace.q, velocity=trace.qd,
+                   effort=trace.tau)
+    log.log_series("/command", t, units="rad", kind="position", name=JOINT_NAMES, value=trace.q_cmd)
     reference = trace.q_cmd if q_ref is None else q_ref
-    log.log_series("/reference", t, name=JOINT_NAMES, position=reference)
+    log.log_series("/reference", t, units="rad", name=JOINT_NAMES, position=reference)
     error = reference - trace.q
-    log.log_series("/tracking_error", t, name=JOINT_NAMES, error=error, norm=np.linalg.norm(error, axis=1))
-    log.log_series("/joint_state/motor", t, name=JOINT_NAMES, effort=trace.tau_motor)   # the saturating part
+    log.log_series("/tracking_error", t, units="rad", name=JOINT_NAMES, error=error, norm=np.linalg.norm(error, axis=1))
+    log.log_series("/joint_state/motor", t, units="rad", name=JOINT_NAMES,
+                   effort=trace.tau_motor)   # the saturating part
     f = trace.contact_force
     log.log_series("/wrench", t, frame_id="world", name=list(LEGS), force_x=f[..., 0], force_y=f[..., 1],
                    force_z=f[..., 2], torque_x=np.zeros_like(f[..., 0]), torque_y=np.zeros_like(f[..., 0]),
                    torque_z=np.zeros_like(f[..., 0]))
-    log.log_series("/contact", t, schemas.Scalars, name=list(LEGS), value=trace.contact)
+    log.log_series("/contact", t, schemas.Scalars, units="1", name=list(LEGS), value=trace.contact)
     rpy, v = trace.rpy, trace.trunk_velocity
     log.log_series("/body", t, Trunk, x=trace.qpos[:, 0], y=trace.qpos[:, 1], z=trace.qpos[:, 2], roll=rpy[:, 0],
                    pitch=rpy[:, 1], yaw=rpy[:, 2], vx=v[:, 0], vy=v[:, 1], vz=v[:, 2])
     feet = kin.fk(leg, trace.q.reshape(-1, 4, 3))
     log.log_series("/feet", t, Feet, name=FEET_FIELDS, position=feet.reshape(len(t), -1))
     if feet_ref is not None:
-        log.log_series("/reference/feet", t, name=FEET_FIELDS, position=feet_ref.reshape(len(t), -1))
+        log.log_series("/reference/feet", t, units="m", name=FEET_FIELDS, position=feet_ref.reshape(len(t), -1))
         e = feet_ref - feet
-        log.log_series("/tracking_error/feet", t, name=FEET_FIELDS, error=e.reshape(len(t), -1),
+        log.log_series("/tracking_error/feet", t, units="m", name=FEET_FIELDS, error=e.reshape(len(t), -1),
                        norm=np.linalg.norm(e.reshape(len(t), -1), axis=1))
     if len(plant.idx.platform_qpos):
         bench = trace.qpos[:, plant.idx.platform_qpos]
@@ -164,9 +174,11 @@ def tables(cfg: DictConfig) -> list[Case]:
         for table, spec in sc.tables.items():
             columns = list(spec.columns)
             for row, values in spec.rows.items():
-                log.log("/tables", t, TableRow, table=table, row=row, name=columns, value=[float(v) for v in values])
+                log.log("/tables", t, TableRow, units=printed_units(columns), table=table, row=row, name=columns,
+                        value=[float(v) for v in values])
                 t += 1e-3   # one row per millisecond: a table is a sequence of records, not a trajectory
-        log.log("/text", 0.0, schemas.Scalars, name=list(sc.text), value=[float(v) for v in sc.text.values()])
+        log.log("/text", 0.0, schemas.Scalars, units=printed_units(sc.text), name=list(sc.text),
+                value=[float(v) for v in sc.text.values()])
 
     return [Case("paper-data", simulate_)]
 
@@ -187,17 +199,18 @@ def kinematics(cfg: DictConfig) -> list[Case]:
         curve = bezier(P, s)
         casteljau = np.array([de_casteljau(P, x) for x in s])
         times = s * trot.swing_time
-        log.log_series("/reference/bezier", times, name=["a", "d"], position=curve)
-        log.log_series("/bezier/de_casteljau", times, schemas.Scalars, name=["a_m", "d_m"], value=casteljau)
+        log.log_series("/reference/bezier", times, units="m", name=["a", "d"], position=curve)
+        log.log_series("/bezier/de_casteljau", times, schemas.Scalars, units="m", name=["a_m", "d_m"], value=casteljau)
         # the swing in the leg frame and its joint angles, with both forms of eq. (40)
         phase = s * trot.swing_fraction
         swing = np.stack([np.full_like(s, trot.lateral), trot.curve(phase)[:, 1],
                           trot.a_sign * trot.curve(phase)[:, 0]], axis=1)
         q = kin.ik(corrected, swing)
-        log.log_series("/reference", times, name=list(kin.JOINTS), position=q)
+        log.log_series("/reference", times, units="rad", name=list(kin.JOINTS), position=q)
         for name, leg in (("corrected", corrected), ("printed", printed)):
             err = np.linalg.norm(kin.fk(corrected, kin.ik(leg, swing)) - swing, axis=1)
-            log.log_series(f"/ik/bezier/{name}", times, schemas.Scalars, name=["fk_ik_error_m"], value=err[:, None])
+            log.log_series(f"/ik/bezier/{name}", times, schemas.Scalars, units="m", name=["fk_ik_error_m"],
+                           value=err[:, None])
         # the workspace: random poses on the IK's branch (θ3 ∈ (0, π), foot below the femur joint)
         rng = np.random.default_rng(cfg.seed)
         lo, hi = robot.ranges[:, 0], robot.ranges[:, 1]
@@ -209,7 +222,7 @@ def kinematics(cfg: DictConfig) -> list[Case]:
         values = [np.linalg.norm(kin.fk(corrected, kin.ik(corrected, p_ws)) - p_ws, axis=1),
                   np.abs(kin.ik(corrected, p_ws) - q_ws).max(axis=1),
                   np.linalg.norm(kin.fk(corrected, kin.ik(printed, p_ws)) - p_ws, axis=1)]
-        log.log_series("/ik/workspace", sample_t, schemas.Scalars,
+        log.log_series("/ik/workspace", sample_t, schemas.Scalars, units=["m", "rad", "m"],
                        name=["fk_ik_error_m", "ik_fk_error_rad", "printed_fk_ik_error_m"],
                        value=np.column_stack(values))
         # Table 5's feet in the body frame
@@ -296,8 +309,10 @@ def body_poses(cfg: DictConfig) -> list[Case]:
         log_trace(log, plant, trace, cfg)
         commanded = schedule(trace.t)
         scenario = schedule.holding(trace.t).astype(float)
-        log.log_series("/reference/body", trace.t, name=["x", "y", "z", "roll", "pitch", "yaw"], position=commanded)
-        log.log_series("/scenario", trace.t, schemas.Scalars, name=["holding"], value=(scenario + 1)[:, None])
+        log.log_series("/reference/body", trace.t, units=["m", "m", "m", "rad", "rad", "rad"],
+                       name=["x", "y", "z", "roll", "pitch", "yaw"], position=commanded)
+        log.log_series("/scenario", trace.t, schemas.Scalars, units="1", name=["holding"],
+                       value=(scenario + 1)[:, None])
         finish(trace)
 
     return [Case("fig18", simulate_)]
@@ -365,7 +380,7 @@ def trot(cfg: DictConfig) -> list[Case]:
         steady = controller.start + (sc.ramp_cycles + sc.skip_cycles) * gait.period
         log.log("/gait/timing", 0.0, GaitTiming, cycle_time=gait.period, swing_time=gait.swing_time,
                 trot_start=controller.start, steady_start=steady)
-        log.log_series("/gait", trace.t, schemas.Scalars,
+        log.log_series("/gait", trace.t, schemas.Scalars, units="1",
                        name=[*(f"swing.{leg}" for leg in LEGS), *(f"phase.{leg}" for leg in LEGS), "stride_scale"],
                        # swing: 1 in swing; phase: share of the cycle; stride_scale: share of the paper's stride
                        value=np.column_stack([swing, gait.phase(np.maximum(trace.t - controller.start, 0.0)),

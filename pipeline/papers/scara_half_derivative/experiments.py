@@ -20,11 +20,15 @@ from pipeline.papers.scara_half_derivative.controller import CartesianController
 from pipeline.papers.scara_half_derivative.mujoco_model import model_xml, qpos
 from pipeline.papers.scara_half_derivative.setpoint import Motion
 
+EXTERNAL_UNITS = ["m", "m", "m", "rad"]   # x, y, z of E and its heading theta
+
+
 Indexes = schemas.define(
     "ClosedLoopIndexes", "Table 2's indexes and eqs. (18)-(19) of one closed-loop run over [0, T_sim], on every "
     "integration step: max and mean |e| of x, y, z in that order (m), ISE = ∫(e_x² + e_y² + e_z²) dt "
     "(trapezoid, m²s), ICE = Σ_i ∫τ_i² dt of the applied torques (N²m²s), max |τ_i| of joints 1-4 (N m).",
-    e_max_m="double[]", e_mean_m="double[]", ise_m2s="double", ice_N2m2s="double", tau_max_Nm="double[]",
+    e_max_m="double[] m", e_mean_m="double[] m", ise_m2s="double m^2 s", ice_N2m2s="double N^2 m^2 s",
+    tau_max_Nm="double[] N m",
 )
 
 
@@ -111,16 +115,17 @@ def log_closed_loop(log: RunWriter, cfg: DictConfig, arm: Arm, motion: Motion, r
     held = tau[np.minimum((t / step + 1e-9).astype(int), len(tau) - 1)]
     command = slice(None, None, max(1, round(ex.log_dt / step)))   # a sweep's runs are logged to look at
     error = x_d - fk(arm, q)
-    log.log_series("/reference", t, name=list(EXTERNAL), position=x_d, velocity=xd_d, acceleration=xdd_d)
-    log.log_series("/joint_state", t, name=list(JOINTS), position=q, velocity=qd, effort=held)
-    log.log_series("/tracking_error", t, name=list(EXTERNAL), error=error,
-                   norm=np.linalg.norm(error[:, :3], axis=1))
-    log.log_series("/command", t_tau[command], kind="torque", name=list(JOINTS), value=tau[command])
+    log.log_series("/reference", t, units=EXTERNAL_UNITS, name=list(EXTERNAL), position=x_d, velocity=xd_d,
+                   acceleration=xdd_d)
+    log.log_series("/joint_state", t, units="rad", name=list(JOINTS), position=q, velocity=qd, effort=held)
+    log.log_series("/tracking_error", t, units=EXTERNAL_UNITS, field_units={"norm": "m"}, name=list(EXTERNAL),
+                   error=error, norm=np.linalg.norm(error[:, :3], axis=1))
+    log.log_series("/command", t_tau[command], units="N m", kind="torque", name=list(JOINTS), value=tau[command])
     log.log("/closed_loop/indexes", float(run.t[-1]), Indexes, **indexes(arm, motion, run, cfg.system.control.dt))
     if np.isfinite(run.controller_s).all():   # a batch times no single controller
         log.log_series("/compute_time", run.t_control, name=[law], seconds=run.controller_s[:, None], calls=[1])
     if run.loop_residual is not None:
-        log.log_series("/loop_closure", run.t_control, schemas.Scalars, name=["gap"],
+        log.log_series("/loop_closure", run.t_control, schemas.Scalars, name=["gap"], units="m",
                        value=run.loop_residual[:, None])
     tf = slice(None, None, _stride(ex.tf_dt, dt, "execute.tf_dt"))
     log.log_transforms(run.t[tf], "base", [*LINKS, "E", "setpoint"],
@@ -194,9 +199,11 @@ def setpoint(cfg: DictConfig) -> list[Case]:
         x_d, xd_d, xdd_d = motion(t)
         q_d = ik(arm, x_d)
         qd_d = np.linalg.solve(jacobian(arm, q_d), xd_d[..., None])[..., 0]
-        log.log_series("/reference", t, name=list(EXTERNAL), position=x_d, velocity=xd_d, acceleration=xdd_d)
-        log.log_series("/reference/joints", t, schemas.Reference, name=list(JOINTS), position=q_d, velocity=qd_d)
-        log.log_series("/setpoint/check", t, schemas.Scalars, name=["fk_ik_error"],
+        log.log_series("/reference", t, units=EXTERNAL_UNITS, name=list(EXTERNAL), position=x_d, velocity=xd_d,
+                       acceleration=xdd_d)
+        log.log_series("/reference/joints", t, schemas.Reference, units="rad", name=list(JOINTS), position=q_d,
+                       velocity=qd_d)
+        log.log_series("/setpoint/check", t, schemas.Scalars, name=["fk_ik_error"], units="m & rad",
                        value=np.abs(fk(arm, q_d) - x_d).max(axis=1)[:, None])
         tf = slice(None, None, max(1, round(cfg.scenario.tf_dt / cfg.scenario.dt)))
         log.log_transforms(t[tf], "base", [*LINKS, "E", "setpoint"], _frames_with_end_effector(arm, q_d[tf], x_d[tf]))

@@ -120,15 +120,15 @@ def log_robot(log: RunWriter, m: Model, robot: str, traj: Trajectory, k: int, tf
     c = controls(robot_model(m, k), state, p_d, v_d)
     t = traj.t
     error = np.column_stack(c["error"])
-    log.log_series("/reference", t, name=XYZ, position=p_d, velocity=p_d_dot)
-    log.log_series("/tracking_error", t, name=XYZ, error=error, norm=np.linalg.norm(error, axis=1))
+    log.log_series("/reference", t, units="m", name=XYZ, position=p_d, velocity=p_d_dot)
+    log.log_series("/tracking_error", t, units="m", name=XYZ, error=error, norm=np.linalg.norm(error, axis=1))
     rates = np.column_stack([c["roll"], c["tilt"], c["turn"]])
-    log.log_series("/joint_state", t, name=ANGLES[robot], position=state[:, [5, 4, 3]], velocity=rates)
+    log.log_series("/joint_state", t, units="rad", name=ANGLES[robot], position=state[:, [5, 4, 3]], velocity=rates)
     asked = {"theta_dot": c["roll"], "alpha_dot": c["roll"], "phi_dot": c["tilt_command"], "psi_dot": c["turn"]}
-    log.log_series("/command", t, kind="velocity", name=ACTUATED[robot],
+    log.log_series("/command", t, units="rad", kind="velocity", name=ACTUATED[robot],
                    value=np.column_stack([asked[a] for a in ACTUATED[robot]]))
     saturated = (np.abs(state[:, 4]) >= m.tilt_limit - 1e-12) & bool(m.gains.steering[k])
-    log.log_series("/pursuit", t, schemas.Scalars, name=PURSUIT,
+    log.log_series("/pursuit", t, schemas.Scalars, name=PURSUIT, units=["rad", "1", "m/s", "1"],
                    value=np.column_stack([c["zeta"], c["g"], v_d, saturated.astype(float)]))
     # 3-D replay: contact frame [ĥ l̂ n̂] at P0, the shell at O_Sp (eq. 51), the target on the surface
     h, lat, n = (np.column_stack(v) for v in (c["h"], c["l"], c["n"]))

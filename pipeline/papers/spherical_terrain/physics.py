@@ -42,6 +42,7 @@ CONTACT_SCALE = 0.01   # m/N: the 2 kg ball's ~20 N ground force drawn 20 cm lon
 # ball's contact velocity is from the paper's and from rigid rolling, slip speed, gap, drive error |ω − ω_cmd|
 PHYSICS = ["actual_speed", "paper_speed", "paper_model_error", "rigid_model_error", "slip_speed", "gap",
            "omega_error"]
+PHYSICS_UNITS = ["m/s", "m/s", "m/s", "m/s", "m/s", "m", "rad/s"]
 
 
 def terrain_mjcf(terrain: CosineTerrain, radius: float, p: DictConfig, centers: np.ndarray) -> str:
@@ -226,15 +227,16 @@ def physics_check(cfg: DictConfig) -> list[Case]:
         center = ball["center"][every, k]
         if not np.isfinite(center).all() or np.abs(center[:, :2]).max() > s.physics.half_extent:
             raise SimulationFailed("the ball left the height field")
-        log.log_series("/reference", t, name=XYZ, position=p_d, velocity=ball["p_d_dot"][every, k])
+        log.log_series("/reference", t, units="m", name=XYZ, position=p_d, velocity=ball["p_d_dot"][every, k])
         for topic, actual in (("/tracking_error", r["contact"]),
                               ("/tracking_error/kinematic_model", kinematic.state[:, k, :3])):
             error = p_d - actual
-            log.log_series(topic, t, name=XYZ, error=error, norm=np.linalg.norm(error, axis=1))
+            log.log_series(topic, t, units="m", name=XYZ, error=error, norm=np.linalg.norm(error, axis=1))
         command = ball["omega_command"][every, k]
-        log.log_series("/command", t, kind="angular_velocity", name=["omega_x", "omega_y", "omega_z"], value=command)
+        log.log_series("/command", t, units="rad", kind="angular_velocity", name=["omega_x", "omega_y", "omega_z"],
+                       value=command)
         norm = np.linalg.norm
-        log.log_series("/physics", t, schemas.Scalars, name=PHYSICS, value=np.column_stack([
+        log.log_series("/physics", t, schemas.Scalars, name=PHYSICS, units=PHYSICS_UNITS, value=np.column_stack([
             norm(r["actual"], axis=1), norm(r["paper"], axis=1), norm(r["actual"] - r["paper"], axis=1),
             norm(r["actual"] - r["rigid"], axis=1), r["slip"], r["gap"], norm(r["omega"] - command, axis=1)]))
         tf = slice(None, None, max(1, round(s.tf_dt / s.dt)))

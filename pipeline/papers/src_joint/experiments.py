@@ -37,6 +37,8 @@ from pipeline.robotics.transforms import quaternion_wxyz
 
 AXES = ["x", "y", "z"]
 CONTACT_SCALE = 0.01   # m/N: the joint's normal force drawn 1 cm per newton
+SIX_UNITS = ["rad/s", "rad/s", "rad/s", "m/s", "m/s", "m/s"]   # wx, wy, wz, vx, vy, vz
+TARGET_UNITS = ["m", "m", "m", "1", "1", "1", "1"]             # x, y, z and a unit quaternion
 EULER = ["X", "Y", "Z"]   # intrinsic XYZ Euler angles (MATLAB rotm2eul(·, 'XYZ'), the paper's Figs. 9, 13, 14)
 
 
@@ -154,27 +156,31 @@ def joint_model(cfg: DictConfig) -> list[Case]:
             log.attach("model.xml", xml, "application/xml")
         model = model_beside(plant, lower, upper, forms[variant])
         t = plant.times
-        log.log_series("/reference", t, name=["x", "y"], velocity=np.tile(command, (len(t), 1)))
-        log.log_series("/tangent_rate", t, schemas.Scalars, name=AXES, value=plant.rates)
+        log.log_series("/reference", t, units="rad", name=["x", "y"], velocity=np.tile(command, (len(t), 1)))
+        log.log_series("/tangent_rate", t, schemas.Scalars, units="rad/s", name=AXES, value=plant.rates)
         rotvec = Rotation.from_matrix(plant.rotation).as_rotvec()
-        log.log_series("/joint_state", t, name=AXES, position=rotvec, velocity=plant.joint_velocity)
-        log.log_series("/joint_state/model", t, name=AXES, position=Rotation.from_matrix(model["rotation"]).as_rotvec(),
+        log.log_series("/joint_state", t, units="rad", name=AXES, position=rotvec, velocity=plant.joint_velocity)
+        log.log_series("/joint_state/model", t, units="rad", name=AXES,
+                       position=Rotation.from_matrix(model["rotation"]).as_rotvec(),
                        velocity=model["joint_velocity"])
         six = ["wx", "wy", "wz", "vx", "vy", "vz"]
-        log.log_series("/spatial_velocity", t, schemas.Scalars, name=six, value=plant.spatial_velocity)
-        log.log_series("/spatial_velocity/model", t, schemas.Scalars, name=six, value=model["spatial_velocity"])
+        log.log_series("/spatial_velocity", t, schemas.Scalars, units=SIX_UNITS, name=six, value=plant.spatial_velocity)
+        log.log_series("/spatial_velocity/model", t, schemas.Scalars, units=SIX_UNITS, name=six,
+                       value=model["spatial_velocity"])
         error = np.swapaxes(model["rotation"], -1, -2) @ plant.rotation     # R_modelᵀ R_plant (Fig. 9)
-        log.log_series("/tracking_error", t, name=EULER, error=euler_xyz(error), norm=angle_of(error))
+        log.log_series("/tracking_error", t, units="rad", name=EULER, error=euler_xyz(error), norm=angle_of(error))
         dw = model["joint_velocity"] - plant.joint_velocity
-        log.log_series("/tracking_error/joint_velocity", t, name=AXES, error=dw, norm=np.linalg.norm(dw, axis=1))
+        log.log_series("/tracking_error/joint_velocity", t, units="rad/s", name=AXES, error=dw,
+                       norm=np.linalg.norm(dw, axis=1))
         dnu = model["spatial_velocity"] - plant.spatial_velocity
-        log.log_series("/tracking_error/spatial_velocity", t, name=six, error=dnu, norm=np.linalg.norm(dnu, axis=1))
+        log.log_series("/tracking_error/spatial_velocity", t, units=SIX_UNITS, field_units={"norm": "rad/s & m/s"},
+                       name=six, error=dnu, norm=np.linalg.norm(dnu, axis=1))
         on_lower, on_upper = contact_paths(lower, upper, plant.tangent, plant.rotation)
-        log.log_series("/contact_path", t, schemas.Scalars, name=["lower", "upper"],
+        log.log_series("/contact_path", t, schemas.Scalars, units="m", name=["lower", "upper"],
                        value=np.column_stack([on_lower, on_upper]))
         if plant.torque is not None:
-            log.log_series("/command", t, kind="torque", name=AXES, value=plant.torque)
-            log.log_series("/contact", t, schemas.Scalars, value=plant.contact,
+            log.log_series("/command", t, units="rad", kind="torque", name=AXES, value=plant.torque)
+            log.log_series("/contact", t, schemas.Scalars, value=plant.contact, units=["m", "N", "N"],
                            name=["penetration", "normal_force", "friction_force"])
         frames = _joint_pose_frames(plant, model, lower, upper)
         log.log_transforms(t, "world", ["B0", "B1", "B1_model", "P1"], frames)
@@ -207,18 +213,21 @@ def log_manipulator(log: RunWriter, trace: Trace, r_desired: np.ndarray, q_desir
     joints = quaternion_of(a["relative"])                     # q_i, η ≥ 0
     joint_rot = qlog(joints)
     w = np.concatenate([a["joint_velocity"], np.zeros((len(t), n, 1))], axis=-1)
-    log.log_series("/joint_state", t, name=joint_names(n, AXES), position=joint_rot.reshape(len(t), -1),
+    log.log_series("/joint_state", t, units="rad", name=joint_names(n, AXES), position=joint_rot.reshape(len(t), -1),
                    velocity=w.reshape(len(t), -1))
-    log.log_series("/src_state", t, schemas.Scalars, name=joint_names(n, ["qw", "qx", "qy", "qz", "nx", "ny", "nz"]),
+    log.log_series("/src_state", t, schemas.Scalars, units="1",   # unit quaternions and unit normals
+                   name=joint_names(n, ["qw", "qx", "qy", "qz", "nx", "ny", "nz"]),
                    value=np.concatenate([joints, a["tangent"][..., 2]], axis=-1).reshape(len(t), -1))
-    log.log_series("/trolley", t, schemas.Scalars, name=joint_names(n, ["heading", "arc", "u_forward", "u_steer"]),
+    log.log_series("/trolley", t, schemas.Scalars, units=["rad", "m", "m/s", "rad/s"] * n,
+                   name=joint_names(n, ["heading", "arc", "u_forward", "u_steer"]),
                    value=np.stack([a["heading"], a["arc"], a["u_forward"], a["u_steer"]], axis=-1).reshape(len(t), -1))
-    log.log_series("/command", t, kind="wheel speed", name=joint_names(n, ["right", "left"]),
+    log.log_series("/command", t, units="rad", kind="wheel speed", name=joint_names(n, ["right", "left"]),
                    value=a["wheels"].reshape(len(t), -1))
     e_p = r_desired - frames[:, -1, :3, 3]
-    log.log_series("/tracking_error", t, name=AXES, error=e_p, norm=np.linalg.norm(e_p, axis=1))
+    log.log_series("/tracking_error", t, units="m", name=AXES, error=e_p, norm=np.linalg.norm(e_p, axis=1))
     R_err = rotation(q_desired) @ np.swapaxes(frames[:, -1, :3, :3], -1, -2)     # R_d Rᵀ
-    log.log_series("/tracking_error/orientation", t, name=EULER, error=euler_xyz(R_err), norm=angle_of(R_err))
+    log.log_series("/tracking_error/orientation", t, units="rad", name=EULER, error=euler_xyz(R_err),
+                   norm=angle_of(R_err))
     target = poses(r_desired, rotation(q_desired))
     bodies = [f"B{i}" for i in range(n + 1)]
     log.log_transforms(t, "world", [*bodies, "target"],
@@ -250,13 +259,14 @@ def random_targets(cfg: DictConfig, radii: np.ndarray, form: ModelForm) -> dict[
 
 def log_ik(log: RunWriter, ik: IkResult) -> None:
     """The IK's convergence and per-iteration compute time, on the IK's own time axis (from t = 0)."""
-    log.log_series("/ik", ik.times, schemas.Scalars, name=["position_error", "orientation_error", "sigma_min"],
+    log.log_series("/ik", ik.times, schemas.Scalars, units=["m", "rad", "m & 1"],  # J mixes m/rad and 1
+                   name=["position_error", "orientation_error", "sigma_min"],
                    value=np.column_stack([np.linalg.norm(ik.position_error, axis=1),
                                           np.linalg.norm(ik.orientation_error, axis=1), ik.sigma_min]))
     log.log_series("/compute_time", ik.times, name=["ik_iteration"], calls=[1], seconds=ik.seconds[:, None])
     solution = ik.chain.joint_quaternions()
     names = [*joint_names(ik.chain.n, ["qw", "qx", "qy", "qz"]), "converged"]
-    log.log("/ik/solution", 0.0, schemas.Scalars, name=names,
+    log.log("/ik/solution", 0.0, schemas.Scalars, name=names, units="1",
             value=[*np.where(solution[:, :1] < 0, -solution, solution).ravel(), float(ik.converged)])
 
 
@@ -285,10 +295,10 @@ def reach_poses(cfg: DictConfig) -> list[Case]:
         arm = FreeBotArm(n, c.bot, s.freebot.radius, s.trolley.heading0, defects)
         trace = position_mode(arm, c, ik.chain.tangent_frames(), sc.duration, plant.sensing)
         a = log_manipulator(log, trace, r_desired, q_desired, s.freebot.radius + defects.radius_offset)
-        log.log_series("/reference", a["times"], name=joint_names(n, ["arc_left", "heading"]),
+        log.log_series("/reference", a["times"], units=["m", "rad"] * n, name=joint_names(n, ["arc_left", "heading"]),
                        position=a["reference"].reshape(len(a["times"]), -1))
         log.log("/target", 0.0, schemas.Scalars, name=["x", "y", "z", "qw", "qx", "qy", "qz"],
-                value=[*r_desired, *q_desired])
+                value=[*r_desired, *q_desired], units=TARGET_UNITS)
 
     for name, plant in sc.plants.items():
         if plant.sensing not in SENSING:
@@ -304,8 +314,8 @@ FloorRow = schemas.define(
     "SrcReachFloor", "The closest a 3-joint equal-sphere chain comes to a target pose: one joint-update mode, one "
     "reading of the target quaternion, one weighting of orientation against position (m per rad), and the most the "
     "closed-form kinematics differs from the paper's model (every model form) at that configuration (m).",
-    mode="string", reading="string", weight_m_per_rad="double", position_error_m="double",
-    orientation_error_rad="double", model_difference_m="double",
+    mode="string", reading="string", weight_m_per_rad="double m/rad", position_error_m="double m",
+    orientation_error_rad="double rad", model_difference_m="double m",
 )
 
 
@@ -354,7 +364,7 @@ def reach_floor(cfg: DictConfig) -> list[Case]:
                               ik, k.dt, k.duration, k.tol_position, k.tol_orientation, k.stall_time, k.stall_change)
             rows += [np.linalg.norm(result.position_error[-1]), np.linalg.norm(result.orientation_error[-1]),
                      float(result.converged), np.abs(result.chain.joint_quaternions()[:, 3]).max()]
-        log.log("/reach/ik", 0.0, schemas.Scalars,
+        log.log("/reach/ik", 0.0, schemas.Scalars, units=["m", "rad", "1", "1"] * len(f.modes),
                 name=[f"{m}.{x}" for m in f.modes for x in ("position_error", "orientation_error", "converged",
                                                            "eps_z_max")], value=rows)
         if best is not None:   # the closest exact-rolling pose, to look at beside the target
@@ -364,7 +374,8 @@ def reach_floor(cfg: DictConfig) -> list[Case]:
             log.log_transforms(np.zeros(1), "world", [*bodies, "target"],
                                np.concatenate([poses(pos, rot), target_pose[None, None]], axis=1))
             log_spheres(log, bodies, [radius] * (n + 1), [BASE_COLOR] + [LINK_COLOR] * n)
-            log.log("/joint_state", 0.0, name=joint_names(n, AXES), position=best.rotvecs.ravel().tolist())
+            log.log("/joint_state", 0.0, units="rad", name=joint_names(n, AXES),
+                    position=best.rotvecs.ravel().tolist())
 
     def simulate_loop(log: RunWriter) -> None:
         """One joint rolled round a closed square of Ω^B (+x, +y, −x, −y): the model in both joint-update
@@ -383,12 +394,12 @@ def reach_floor(cfg: DictConfig) -> list[Case]:
                 plant.roll(sides[j:j + 1], dt)
         quaternions *= np.where(quaternions[..., :1] < 0, -1.0, 1.0)
         t = np.arange(len(sides) + 1) * dt
-        log.log_series("/joint_state", t, name=[f"{m}.{a}" for m in (*reach.MODES, "plant") for a in AXES],
+        log.log_series("/joint_state", t, units="rad", name=[f"{m}.{a}" for m in (*reach.MODES, "plant") for a in AXES],
                        position=qlog(quaternions).reshape(len(t), -1))
-        log.log_series("/eq5/joint_quaternion", t, schemas.Scalars,
+        log.log_series("/eq5/joint_quaternion", t, schemas.Scalars, units="1",
                        name=[f"{m}.{c}" for m in (*reach.MODES, "plant") for c in ("qw", "qx", "qy", "qz")],
                        value=quaternions.reshape(len(t), -1))
-        log.log_series("/reference", t[:-1], name=["x", "y"], velocity=sides)
+        log.log_series("/reference", t[:-1], units="rad", name=["x", "y"], velocity=sides)   # Ω^B, rad/s
 
     cases = [Case(name, lambda log, x=name: simulate_target(log, x)) for name in sc.targets]
     return [*cases, Case("eq5-loop", simulate_loop)]
@@ -431,20 +442,21 @@ def avoid_obstacles(cfg: DictConfig) -> list[Case]:
         trace = velocity_mode(arm, c, r_desired, q_desired, bars, qp, sc.duration, avoid=case == "avoid")
         a = log_manipulator(log, trace, r_desired, q_desired, s.freebot.radius)
         t = a["times"]
-        log.log_series("/reference", t, name=joint_names(n, ["x", "y"]), velocity=a["reference"].reshape(len(t), -1))
+        log.log_series("/reference", t, units="rad", name=joint_names(n, ["x", "y"]),
+                       velocity=a["reference"].reshape(len(t), -1))
         centres = a["frames"][:, 1:, :3, 3]
         clearance, _ = bars.clearance(centres.reshape(-1, 3), np.tile(radii[1:], len(t)))
-        log.log_series("/clearance", t, schemas.Scalars, name=pairs, value=clearance.reshape(len(t), -1))
+        log.log_series("/clearance", t, schemas.Scalars, units="m", name=pairs, value=clearance.reshape(len(t), -1))
         xml = scene_xml(radii, bars.points, bars.axis, bars.radius, sc.bars.half_length)
         log.attach("scene.xml", xml, "application/xml")
-        log.log_series("/clearance/mujoco", t, schemas.Scalars, name=pairs,
+        log.log_series("/clearance/mujoco", t, schemas.Scalars, units="m", name=pairs,
                        value=mujoco_clearance(xml, np.concatenate([np.zeros((len(t), 1, 3)), centres], axis=1))[:, 1:]
                        .reshape(len(t), -1))
         log.log_series("/compute_time", t, name=["model", "qp"], calls=[1, 1],
                        seconds=np.column_stack([a["model_seconds"], a["qp_seconds"]]))
-        log.log_series("/qp", t, schemas.Scalars, name=["slack"], value=a["slack"][:, None])
+        log.log_series("/qp", t, schemas.Scalars, name=["slack"], value=a["slack"][:, None], units="m/s")
         log.log("/target", 0.0, schemas.Scalars, name=["x", "y", "z", "qw", "qx", "qy", "qz"],
-                value=[*r_desired, *q_desired])
+                value=[*r_desired, *q_desired], units=TARGET_UNITS)
         bar_markers(log, bars, sc.bars.half_length)
 
     return [Case(case, lambda log, x=case: simulate(log, x)) for case in sc.cases]

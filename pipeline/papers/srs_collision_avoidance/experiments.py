@@ -35,21 +35,22 @@ VARIANTS = {
 Avoidance = schemas.define(
     "SrsAvoidance", "Algorithm 1 at one sample: the nearest obstacle point P_c, the point of the chain under "
     "imminent collision P_col (NaN if none) and the distances, all in the base frame (y up), at the α = 0 posture.",
-    case="string", find="bool", d_mc_m="double", actual_distance_m="double", side_g_m3="double",
-    p_c_m="double[]", p_col_m="double[]", obstacle_distance_m="double", obstacle_capsule="uint32",
+    case="string", find="bool", d_mc_m="double m", actual_distance_m="double m", side_g_m3="double m^3",
+    p_c_m="double[] m", p_col_m="double[] m", obstacle_distance_m="double m", obstacle_capsule="uint32 1",
 )
 Swivel = schemas.define(
     "SrsSwivel", "The swivel angle of Algorithm 1 at one sample: computed α_c, filtered α_f, and α_f's first and "
     "second differences over T (the paper's Figs. 8-9).",
-    alpha_c_rad="double", alpha_f_rad="double", alpha_f_rate_rad_s="double", alpha_f_acceleration_rad_s2="double",
+    alpha_c_rad="double rad", alpha_f_rad="double rad", alpha_f_rate_rad_s="double rad/s",
+    alpha_f_acceleration_rad_s2="double rad/s^2",
 )
 Distances = schemas.define(
     "SrsDistances", "Signed distances per named pair (m): negative inside the safety volume, or overlapping.",
-    name="string[]", distance_m="double[]",
+    name="string[]", distance_m="double[] m",
 )
 Points = schemas.define(
     "SrsPoints", "Named points in the arm's base frame (m; y_b up, as in the paper).",
-    name="string[]", x_m="double[]", y_m="double[]", z_m="double[]",
+    name="string[]", x_m="double[] m", y_m="double[] m", z_m="double[] m",
 )
 
 
@@ -191,11 +192,12 @@ def log_plan(log: RunWriter, cfg: DictConfig, times: np.ndarray, plan: planner.P
     log.log_series("/clearance/capsules", times, Distances, name=pair_names(arms),
                    distance_m=pairs.reshape(len(times), -1))
     dp = T[:, :3, 3] - plan.poses[:, :3, 3]
-    log.log_series("/ik/tool_error", times, schemas.TrackingError, name=[*XYZ, "rotation"],
+    log.log_series("/ik/tool_error", times, schemas.TrackingError, units=["m", "m", "m", "rad"],
+                   field_units={"norm": "m"}, name=[*XYZ, "rotation"],
                    error=np.column_stack([dp, rotation_angle(T[:, :3, :3], plan.poses[:, :3, :3])]),
                    norm=np.linalg.norm(dp, axis=1))
-    log.log_series("/ik/joints", times, schemas.JointState, name=JOINTS, position=plan.q)
-    log.log_series("/ik/alpha0", times, schemas.JointState, name=JOINTS, position=plan.q0)
+    log.log_series("/ik/joints", times, schemas.JointState, units="rad", name=JOINTS, position=plan.q)
+    log.log_series("/ik/alpha0", times, schemas.JointState, units="rad", name=JOINTS, position=plan.q0)
 
 
 def pair_names(arms: HumanArms) -> list[str]:
@@ -251,19 +253,21 @@ def replay(log: RunWriter, cfg: DictConfig, times: np.ndarray, plan: planner.Pla
     every = max(1, round(rp.log_dt / rp.dt))
     t_state = (t + rp.dt)[::every]                    # rollout returns the state after each step
     q, qd, tau = states[::every, 1:8], states[::every, 8:15], sensors[::every, :7]
-    log.log_series("/reference", t[::every], name=JOINTS, position=q_ref[::every], velocity=qd_ref[::every],
+    log.log_series("/reference", t[::every], units="rad", name=JOINTS, position=q_ref[::every],
+                   velocity=qd_ref[::every],
                    acceleration=spline(t[::every], 2))
-    log.log_series("/joint_state", t_state, name=JOINTS, position=q, velocity=qd, effort=tau)
-    log.log_series("/command", t_state, kind="torque", name=JOINTS, value=tau)
+    log.log_series("/joint_state", t_state, units="rad", name=JOINTS, position=q, velocity=qd, effort=tau)
+    log.log_series("/command", t_state, units="rad", kind="torque", name=JOINTS, value=tau)
     err = q_ref[::every] - q
-    log.log_series("/tracking_error", t_state, name=JOINTS, error=err, norm=np.linalg.norm(err, axis=1))
+    log.log_series("/tracking_error", t_state, units="rad", name=JOINTS, error=err, norm=np.linalg.norm(err, axis=1))
     # the tool as MuJoCo measured it, against the desired pose sampled at the same instants
     R_bw = mujoco_replay.R_WORLD_BASE.T
     p_tool = sensors[::every, 7:10] @ R_bw.T
     R_tool = R_bw @ Rotation.from_quat(sensors[::every, 10:14], scalar_first=True).as_matrix()
     desired = fk(spline(t_state), g)    # the planned tool pose between samples (exact at the samples)
     dp = desired[:, :3, 3] - p_tool
-    log.log_series("/tracking_error/tool", t_state, name=[*XYZ, "rotation"],
+    log.log_series("/tracking_error/tool", t_state, units=["m", "m", "m", "rad"], field_units={"norm": "m"},
+                   name=[*XYZ, "rotation"],
                    error=np.column_stack([dp, rotation_angle(desired[:, :3, :3], R_tool)]),
                    norm=np.linalg.norm(dp, axis=1))
     # link frames of the executed motion at the planning samples
@@ -287,13 +291,13 @@ def _simulate(log: RunWriter, cfg: DictConfig, case: str, replayed: bool) -> Non
     times, plan, points, capsules = plan_case(cfg, case)
     arms = humans(cfg)
     log_plan(log, cfg, times, plan, points, capsules, arms)
-    log.log_series("/reference/tool", times, schemas.Reference, name=XYZ, position=plan.poses[:, :3, 3])
+    log.log_series("/reference/tool", times, schemas.Reference, units="m", name=XYZ, position=plan.poses[:, :3, 3])
     if replayed:
         log_scene(log, cfg, geometry(cfg))
         log_collision_points(log, times, plan, cfg.system.filter.dt)
         replay(log, cfg, times, plan, capsules, arms)
     else:
-        log.log_series("/joint_state", times, name=JOINTS, position=plan.q,
+        log.log_series("/joint_state", times, units="rad", name=JOINTS, position=plan.q,
                        velocity=np.gradient(plan.q, times, axis=0))
 
 
@@ -320,7 +324,8 @@ def compute_time(cfg: DictConfig) -> list[Case]:
         online = planner.Online(s)
         q = np.array([online.step(*args) for args in inputs])
         gap = np.abs(np.angle(np.exp(1j * (q - batch.q)))).max()
-        log.log("/online_vs_batch", 0.0, schemas.Scalars, name=["max_joint_difference_rad"], value=[float(gap)])
+        log.log("/online_vs_batch", 0.0, schemas.Scalars, units="rad", name=["max_joint_difference_rad"],
+                value=[float(gap)])
         timings = [
             time_calls("algorithm1", planner.Online(s).step, inputs, warmup=sc.warmup, repeats=sc.repeats),
             time_calls("ik", lambda T: ik(T, 0.3, s.geometry), [(T,) for T in poses], warmup=sc.warmup),

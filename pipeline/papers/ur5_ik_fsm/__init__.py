@@ -52,7 +52,7 @@ def __getattr__(name: str):
         from pipeline.papers.ur5_ik_fsm import experiments
 
         return {"tables": experiments.tables, "singular-paths": experiments.singular_paths,
-                "compute-time": experiments.compute_time}
+                "random-paths": experiments.singular_paths, "compute-time": experiments.compute_time}
     raise AttributeError(name)
 
 
@@ -91,10 +91,16 @@ RULES = (
     Rule(("execute.log_dt", "scenario.duration"), lambda log_dt, T: log_dt <= T / 10,
          "execute.log_dt={0:g} s leaves fewer than 10 samples of the {1:g} s path"),
 )
+def _path_steps(c) -> float:
+    return len(c.scenario.paths) * len(c.scenario.algorithms) * len(c.scenario.crossings) * c.scenario.duration \
+        / c.execute.dt
+
+
 BUDGETS = {
-    "singular-paths": Budget("physics steps", lambda c: len(c.scenario.paths) * len(c.scenario.algorithms)
-                             * len(c.scenario.crossings) * c.scenario.duration / c.execute.dt, 5e6,
+    "singular-paths": Budget("physics steps", _path_steps, 5e6,
                              "fewer paths, a shorter scenario.duration or a longer execute.dt"),
+    # per episode, summed over episodes.count: 1e8 steps is 25,000 episodes of 4 s, about an hour on 2 cores
+    "random-paths": Budget("physics steps", _path_steps, 1e8, "a shorter scenario.duration or a longer execute.dt"),
     "compute-time": Budget("IK calls", lambda c: c.scenario.poses * (2 + c.scenario.batch_repeats)
                            + c.scenario.warmup, 5e7, "fewer scenario.poses or scenario.batch_repeats"),
 }

@@ -1,5 +1,6 @@
-"""Speed of `ur5-ik-fsm`: the MuJoCo execution against bare stepping, and IK per call (with the
-compiled `ur-analytic-ik` as a peer when the [bench] extra is installed)."""
+"""Speed of `ur5-ik-fsm`: the MuJoCo execution against bare stepping, IK per call (with the compiled
+`ur-analytic-ik` as a peer when the [bench] extra is installed), and the dataset generator (1,000 randomized
+episodes simulated, logged and exported; goal ≤ 2 minutes on 2 cores)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from pipeline.core.checks import compose_config
-from pipeline.core.runlog import RunWriter
+from pipeline.core.runlog import RunWriter, read_run, run_files
 from pipeline.core.timing import best_of, time_calls
 from pipeline.papers.ur5_ik_fsm import experiments as ex
 from pipeline.papers.ur5_ik_fsm import ik
@@ -108,4 +109,97 @@ def benchmark() -> list[dict]:
     rows: list[dict] = []
     execution(rows)
     ik_per_call(rows)
+    dataset(rows)
     return rows
+
+
+def reader(rows: list[dict], paths: list[Path]) -> None:
+    """Reading every topic of `paths` back: series of one fixed layout as NumPy arrays (the reader's default)
+    against decoding each message with protobuf; messages per second, both in this one process."""
+    import time
+
+    from pipeline.core.decoding import read_topics
+
+    topics = read_run(paths[0]).topic_names
+    messages = sum(read_run(p).message_count(t) for p in paths for t in topics)
+    for arrays, measure in ((False, "message by message (protobuf)"), (True, "fixed-layout series as arrays")):
+        seconds = []
+        for _ in range(3):
+            start = time.perf_counter()
+            for p in paths:
+                read_topics(p, topics, arrays=arrays)
+            seconds.append(time.perf_counter() - start)
+        rows.append({"what": f"reader: every topic of {len(paths)} random-paths runs ({messages} messages)",
+                     "measure": measure, "value": messages / float(np.median(seconds)), "unit": "messages/s"})
+
+
+def dataset(rows: list[dict], episodes: int = 1000) -> None:
+    """The dataset generator end to end, as a user runs it: `episodes` randomized paths (random-paths) simulated
+    and logged in one process over the cores, then exported as a LeRobot dataset; and where one episode's time
+    goes, measured in this process on a few episodes."""
+    import subprocess
+    import sys
+    import time
+
+    import yaml
+    from omegaconf import OmegaConf
+
+    from pipeline.core import episodes as ep
+    from pipeline.core import parallel
+    from pipeline.core.experiment import resolve
+    from pipeline.core.runner import _run_case
+
+    what = f"dataset generator: {episodes} random-paths episodes"
+    with tempfile.TemporaryDirectory() as tmp:
+        start = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "pipeline", "experiment=ur5-ik-fsm/random-paths",
+                        f"episodes.count={episodes}", f"data_dir={tmp}", "progress=false"], check=True,
+                       capture_output=True)
+        simulated = time.perf_counter() - start
+        subprocess.run([sys.executable, "-m", "pipeline.dataset", "ur5-ik-fsm/random-paths", "--data-dir", tmp],
+                       check=True, capture_output=True)
+        total = time.perf_counter() - start
+        size = sum(p.stat().st_size for p in (Path(tmp) / "datasets").rglob("*") if p.is_file())
+        reader(rows, run_files(Path(tmp) / "runs/ur5-ik-fsm/random-paths")[:40])
+    workers = parallel.workers_for(0, episodes)
+    rows += [
+        {"what": what, "measure": f"simulate + log ({workers} workers, one process start)", "value": simulated,
+         "unit": "s"},
+        {"what": what, "measure": "export to LeRobot v3.0 (one process)", "value": total - simulated, "unit": "s"},
+        {"what": what, "measure": "simulated, logged and exported", "value": total, "unit": "s", "goal": "≤ 120"},
+        {"what": what, "measure": "episodes per second", "value": episodes / total, "unit": "1/s"},
+        {"what": what, "measure": "dataset size", "value": size / 1e6, "unit": "MB"},
+    ]
+    # one episode's parts (one core): drawing the config, the IK along the path, MuJoCo, logging + writing
+    cfg = compose_config(["experiment=ur5-ik-fsm/random-paths"])
+    experiment = resolve("ur5-ik-fsm/random-paths")
+    base = OmegaConf.to_container(cfg, resolve=True)
+    parts: dict[str, list[float]] = {"config": [], "IK along the path (2001 scalar calls)": [],
+                                     "MuJoCo servo (rollout)": [], "logging + MCAP write": [], "episode": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        for index in range(12):
+            t0 = time.perf_counter()
+            plain = ep.apply(base, ep.draw(cfg, index), ep.seed_of(cfg, index))
+            episode_cfg = OmegaConf.create(plain)
+            case = experiment.fn(episode_cfg)[0]
+            config_yaml = yaml.safe_dump(plain, sort_keys=False)
+            t1 = time.perf_counter()
+            path, crossing, algorithm = case.id.split("-")
+            ik_times, _, q_ik, _ = ex.solve_path(episode_cfg, path, crossing, algorithm)
+            t2 = time.perf_counter()
+            times, q_ref, qd_ref = ex.servo_references(q_ik, ik_times, episode_cfg.execute.dt, True,
+                                                       episode_cfg.system.dynamics.velocity_limit)
+            servo_rollout(ex.arm_model(episode_cfg, ex.geometry(episode_cfg), q_ref[0]), q_ref, qd_ref, times)
+            t3 = time.perf_counter()
+            _run_case(case, f"e{index}", Path(tmp), config_yaml, {"run_id": f"e{index}"})
+            t4 = time.perf_counter()
+            if index:  # the first one warms caches
+                full = t4 - t3
+                parts["config"].append(t1 - t0)
+                parts["IK along the path (2001 scalar calls)"].append(t2 - t1)
+                parts["MuJoCo servo (rollout)"].append(t3 - t2)
+                parts["logging + MCAP write"].append(full - (t3 - t1))
+                parts["episode"].append(full + t1 - t0)
+    for part, values in parts.items():
+        rows.append({"what": "one random-paths episode (median of 11)", "measure": part,
+                     "value": float(np.median(values)) * 1e3, "unit": "ms"})

@@ -24,9 +24,9 @@ ALGORITHMS = {"alg1": ik.min_displacement, "alg2": ik.fsm}
 
 IkSelection = schemas.define(
     "Ur5IkSelection", "One IK call of the UR5 paper: the selected set and what it took to find it.",
-    name="string[]", position="double[]", previous="double[]", found="bool", branch="int64",
-    sets_evaluated="uint32", valid_sets="uint32", trace="string", det_j="double", diff="double",
-    fk_error_position="double", fk_error_rotation="double",
+    name="string[]", position="double[] q", previous="double[] q", found="bool", branch="int64 1",
+    sets_evaluated="uint32 1", valid_sets="uint32 1", trace="string", det_j="double m^3", diff="double rad",
+    fk_error_position="double m", fk_error_rotation="double rad",
 )
 
 
@@ -82,11 +82,12 @@ def tables(cfg: DictConfig) -> list[Case]:
         previous = {name: np.zeros(6) for name in ALGORITHMS}
         for k, T in enumerate(poses, start=1):
             t = float(k)  # test k is logged at t = k s: the tests are a sequence, not a trajectory
-            log.log("/ik/generating", t, schemas.Reference, name=JOINTS, position=generating[k - 1].tolist())
+            log.log("/ik/generating", t, schemas.Reference, units="rad", name=JOINTS,
+                    position=generating[k - 1].tolist())
             frames = [T]
             for name, solve in ALGORITHMS.items():
                 sel = solve(T, previous[name], g, c)
-                log.log(f"/ik/{name}", t, IkSelection, **_selection_record(sel, T, previous[name], g))
+                log.log(f"/ik/{name}", t, IkSelection, units="rad", **_selection_record(sel, T, previous[name], g))
                 if sel.q is not None:
                     frames.append(dhk.fk(dh, np.array(sel.q)))
                     if sequential:
@@ -178,18 +179,19 @@ def log_execution(log: RunWriter, cfg: DictConfig, g: Geometry, times, q_ref, qd
     t_state = (times + dt)[every]  # rollout returns the state after each step
     q, qd, tau = states[every, 1:7], states[every, 7:13], sensors[every, :6]
     q_ref, qd_ref = q_ref[every], qd_ref[every]
-    log.log_series("/reference", times[every], name=JOINTS, position=q_ref, velocity=qd_ref)
-    log.log_series("/joint_state", t_state, name=JOINTS, position=q, velocity=qd, effort=tau)
-    log.log_series("/command", t_state, kind="torque", name=JOINTS, value=tau)
+    log.log_series("/reference", times[every], units="rad", name=JOINTS, position=q_ref, velocity=qd_ref)
+    log.log_series("/joint_state", t_state, units="rad", name=JOINTS, position=q, velocity=qd, effort=tau)
+    log.log_series("/command", t_state, units="rad", kind="torque", name=JOINTS, value=tau)
     err = q_ref - q
-    log.log_series("/tracking_error", t_state, name=JOINTS, error=err, norm=np.linalg.norm(err, axis=1))
+    log.log_series("/tracking_error", t_state, units="rad", name=JOINTS, error=err, norm=np.linalg.norm(err, axis=1))
     # flange error of the executed motion against the desired path
     T_des = np.stack([np.interp(t_state, ik_times, poses[:, i, j]) for i in range(4) for j in range(4)],
                      axis=1).reshape(-1, 4, 4)
     T_act = dhk.fk(dh, q)
     dp = T_des[:, :3, 3] - T_act[:, :3, 3]
     rot = rotation_angle(T_des[:, :3, :3], T_act[:, :3, :3])
-    log.log_series("/tracking_error/flange", t_state, name=["x", "y", "z", "rotation"],
+    log.log_series("/tracking_error/flange", t_state, units=["m", "m", "m", "rad"], field_units={"norm": "m"},
+                   name=["x", "y", "z", "rotation"],
                    error=np.column_stack([dp, rot]), norm=np.linalg.norm(dp, axis=1))
     tf = slice(None, None, max(1, round(cfg.execute.tf_dt / dt)))
     t_tf = (times + dt)[tf]
@@ -219,18 +221,37 @@ def solve_path(cfg: DictConfig, path: str, crossing: str, algorithm: str):
     poses = flange_path(path, sc[path], g, ik_times, sc.duration, gap)
     solve = ALGORITHMS[algorithm]
     q_ik = np.full((len(poses), 6), np.nan)
-    records = []
+    selections, previous_sets = [], np.empty((len(poses), 6))
     previous = None
     for k, T in enumerate(poses):
         if previous is None:  # start on the set closest to zero, as the paper's tests do
             start = ik.min_displacement(T, np.zeros(6), g, c)
             previous = np.zeros(6) if start.q is None else np.array(start.q)
         sel = solve(T, previous, g, c)
-        records.append(_selection_record(sel, T, previous, g))
+        selections.append(sel)
+        previous_sets[k] = previous
         if sel.q is not None:
             q_ik[k] = sel.q
             previous = q_ik[k]
-    return ik_times, poses, q_ik, records
+    return ik_times, poses, q_ik, _selection_records(selections, q_ik, previous_sets, poses, g)
+
+
+def _selection_records(selections: list[ik.Selection], q: np.ndarray, previous: np.ndarray, poses: np.ndarray,
+                       g: Geometry) -> dict:
+    """The columns of a path's /ik records, computed for all samples at once (FK by the DH product, equal to
+    eqs. (2)-(13) to 1e-16 m); NaN where no set was found."""
+    found = ~np.isnan(q).any(axis=1)
+    T_q = dhk.fk(dhk.DH.from_config(g.dh), np.where(found[:, None], q, 0.0))
+    nan = np.full(len(q), np.nan)
+    return dict(name=JOINTS, position=q, previous=previous, found=found,
+                branch=np.array([s.branch if s.q is not None else -1 for s in selections], dtype=np.int64),
+                sets_evaluated=np.array([s.sets_evaluated for s in selections], dtype=np.uint32),
+                valid_sets=np.array([s.valid_sets for s in selections], dtype=np.uint32),
+                trace=np.array([s.trace for s in selections]),
+                det_j=np.where(found, det_j(q, g), nan),
+                diff=np.where(found, np.linalg.norm(previous - q, axis=1), nan),  # eq. (48)
+                fk_error_position=np.where(found, np.linalg.norm(T_q[:, :3, 3] - poses[:, :3, 3], axis=1), nan),
+                fk_error_rotation=np.where(found, rotation_angle(T_q[:, :3, :3], poses[:, :3, :3]), nan))
 
 
 def singular_paths(cfg: DictConfig) -> list[Case]:
@@ -240,10 +261,10 @@ def singular_paths(cfg: DictConfig) -> list[Case]:
         ik_times, poses, q_ik, records = solve_path(cfg, path, crossing, algorithm)
         if np.isnan(q_ik[0]).any():
             raise SimulationFailed(f"no valid IK set at the start of the {path} path")
-        for t, rec in zip(ik_times, records, strict=True):
-            log.log(f"/ik/{algorithm}", float(t), IkSelection, **rec)
+        log.log_series(f"/ik/{algorithm}", ik_times, IkSelection, units="rad", **records)
         sing = np.column_stack([np.sin(q_ik[:, 2]), np.sin(q_ik[:, 4]), shoulder_term(q_ik, g), det_j(q_ik, g)])
-        log.log_series("/singularity", ik_times, schemas.Scalars, name=["s3", "s5", "shoulder", "det_j"], value=sing)
+        log.log_series("/singularity", ik_times, schemas.Scalars, name=["s3", "s5", "shoulder", "det_j"], value=sing,
+                       units=["1", "1", "m", "m^3"])  # sin θ3, sin θ5, eq. (46)'s shoulder factor, det J
         execute(log, cfg, q_ik, ik_times, poses, g)
 
     sc = cfg.scenario
@@ -272,7 +293,7 @@ def compute_time(cfg: DictConfig) -> list[Case]:
         sample_t = np.arange(sc.poses) * 1e-3  # one sample per pose, 1 ms apart on the log's time axis
         log.log_series("/compute_time", sample_t, name=list(ALGORITHMS), calls=[1, 1],
                        seconds=np.column_stack([scalar[a].seconds for a in ALGORITHMS]))
-        log.log_series("/ik/counts", sample_t, schemas.Scalars, value=counts,
+        log.log_series("/ik/counts", sample_t, schemas.Scalars, value=counts, units="1",
                        name=["alg1_sets_evaluated", "alg2_sets_evaluated", "valid_sets"])
 
         def batched(algorithm: str):
