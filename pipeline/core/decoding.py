@@ -208,7 +208,6 @@ def _read_topic(f, summary, channel_id: int, decode, arrays: bool = True) -> pd.
 
 
 def _fast_frame(records: np.ndarray, layout: _Layout, first: Message) -> pd.DataFrame:
-    import pandas as pd
 
     row0: dict[str, Any] = {}
     flatten(first, "", row0)

@@ -20,21 +20,30 @@ from pipeline.core.runlog import RunWriter
 from pipeline.papers.gripper_review import curated
 
 _PROTO = {"int64": "int64", "string": "string", "boolean": "bool", "Int64": "double", "float64": "double"}
+
+
+def _field(column: curated.Column) -> str:
+    kind = _PROTO[column.dtype]
+    if kind in ("string", "bool"):
+        return kind
+    return f"{kind} {'1' if column.unit in ('', 'count') else column.unit}"
+
+
 ReviewGripper = schemas.define(
     "ReviewGripper",
     "One gripper the review cites. Numbers in SI, the unit in each field's name (_n N, _m m, _rad rad, _nm "
     "N·m, _w W, _pa Pa); counts (fingers, joints, phalanges, actuators) as doubles; NaN: the review states "
     "none. pipeline/papers/gripper_review/curated.py: COLUMNS says what each field means.",
-    **{name: _PROTO[column.dtype] for name, column in curated.COLUMNS.items()},
+    **{name: _field(column) for name, column in curated.COLUMNS.items()},
 )
 ReviewCell = schemas.define(
     "ReviewCell", "Provenance of one cell of /grippers: where the review prints it, as printed, and the quote.",
-    ref="int64", column="string", printed="string", unit="string", qualifier="string", where="string",
+    ref="int64 1", column="string", printed="string", unit="string", qualifier="string", where="string",
     quote="string", reading="string",
 )
 ReviewTableRow = schemas.define(
     "ReviewTableRow", "One row of a table of the review; cells labelled by `name`, text as printed.",
-    table="string", row="uint32", name="string[]", value="string[]",
+    table="string", row="uint32 1", name="string[]", value="string[]",
 )
 RECORD_DT = 1e-3  # s between records: a table is a sequence of records, not a trajectory
 

@@ -29,9 +29,9 @@ from pipeline.robotics.mjcf import servo_rollout
 KgSize = schemas.define(
     "KgSize", "One kinematic graph (Table 1): resolutions, C-grid and KG sizes, occupied voxels holding k clusters "
     "(clusters_per_voxel[k]); its construction time per stage is on /compute_time at the same log time.",
-    c_res_rad="double", t_res_m="double", jv="int64[]", grid_nodes="int64", grid_edges="int64",
-    grid_edges_closed_form="int64", vertices="int64", edges="int64", occupied_voxels="int64", kg_components="int64",
-    clusters_per_voxel="int64[]",
+    c_res_rad="double rad", t_res_m="double m", jv="int64[] 1", grid_nodes="int64 1", grid_edges="int64 1",
+    grid_edges_closed_form="int64 1", vertices="int64 1", edges="int64 1", occupied_voxels="int64 1",
+    kg_components="int64 1", clusters_per_voxel="int64[] 1",
 )
 KgSearch = schemas.define(
     "KgSearch", "One A* query on one graph (kg, grid: the plain C-grid, tonly: the T-space voxels only). μ is in "
@@ -39,11 +39,12 @@ KgSearch = schemas.define(
     "optimal_cost: the cheapest path's cost (Dijkstra, KG only); lengths of the vertex path (q_i first) in m "
     "(task) and rad (joint); min_base_distance_m: closest approach of P_w to the base axis (z); collision_free: "
     "the joint path interpolated every dense_step is clear of every obstacle.",
-    query="int64", graph="string", metric="string", found="bool", reason="string", vertices="int64",
-    expanded="int64", met="int64", expansions="int64", explored_pct="double", path_vertices="int64", cost="double",
-    h_start="double", optimal_cost="double", t_length_m="double", c_length_rad="double", max_step_rad="double",
-    min_mu="double", mean_mu="double", min_base_distance_m="double", collision_free="bool",
-    min_clearance_m="double", seconds="double",
+    query="int64 1", graph="string", metric="string", found="bool", reason="string", vertices="int64 1",
+    expanded="int64 1", met="int64 1", expansions="int64 1", explored_pct="double %", path_vertices="int64 1",
+    cost="double metric's unit", h_start="double metric's unit", optimal_cost="double metric's unit",
+    t_length_m="double m", c_length_rad="double rad", max_step_rad="double rad", min_mu="double m^dims",
+    mean_mu="double m^dims", min_base_distance_m="double m", collision_free="bool", min_clearance_m="double m",
+    seconds="double s",
 )
 MAX_QUERY_TRIES = 1000   # random start/goal draws per wanted pair before the scene is declared too cluttered
 
