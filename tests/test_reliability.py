@@ -317,7 +317,7 @@ def test_a_run_that_simulates_nothing_is_failed(tmp_path):
         from pathlib import Path
         from pipeline.core.experiment import Case
         from pipeline.core.runner import _run_case
-        print(_run_case(Case("x", lambda log: None), "x", Path({str(tmp_path)!r}), "", {{"run_id": "x"}})[1])
+        print(_run_case(Case("x", lambda log: None), "x", Path({str(tmp_path)!r}), "", {{"run_id": "x"}})[0])
     """)
     proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=ENV, capture_output=True, text=True)
     assert proc.stdout.strip() == "failed: nothing was simulated (no message was logged)", proc.stderr

@@ -21,7 +21,7 @@ def test_a_cluster_sweep_runs_chunks_of_points_per_job_into_its_own_folder(data_
     assert proc.returncode == 0, proc.stderr
     assert "3 sweep points in 2 jobs of up to 2" in proc.stdout + proc.stderr
     runs = [read_run(p) for p in run_files(sweep / "runs/ur5-ik-fsm/tables")]
-    assert sorted(r.params["seed"] for r in runs) == ["0", "0", "1", "1", "2", "2"]
+    assert sorted(r.params["seed"] for r in runs) == [0, 0, 1, 1, 2, 2]  # typed
     assert all(r.ok for r in runs)
     jobs = sorted(p.name for p in (sweep / ".hydra/.submitit").iterdir() if p.name.isdigit())
     assert len(jobs) == 2                                        # two processes, the first ran two points
@@ -31,7 +31,7 @@ def test_a_cluster_sweep_runs_chunks_of_points_per_job_into_its_own_folder(data_
     proc = run_cli("analysis", f"data_dir={sweep}", "experiment=ur5-ik-fsm/tables")
     assert proc.returncode == 0, proc.stderr
     metrics = pd.read_parquet(sweep / "metrics/ur5-ik-fsm/tables.parquet")
-    assert set(metrics["seed"].dropna()) == {"0", "1", "2"}                # the swept parameter, a column
+    assert set(metrics["seed"].dropna()) == {0, 1, 2}                    # the swept parameter, a column
     targets = pd.read_csv(sweep / "report/targets.csv")
     other = set(targets.loc[targets["slug"] == "spherical-terrain", "status"])    # a paper this sweep did not run
     assert "not run" in other and other <= {"not run", "not-reproducible"}

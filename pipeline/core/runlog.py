@@ -373,6 +373,8 @@ class RunWriter:
     # -- lifecycle --------------------------------------------------------------------------------
     def _flush_topics(self) -> None:
         for topic, parts in self._pending.items():
+            if not parts:  # declared, but its first record failed (a bug the run's status names)
+                continue
             kind = self._types[topic]
             if isinstance(kind, tuple):  # a ROS 2 message (mixed encodings in one file are part of MCAP)
                 name, encoding, definition, message_encoding = kind
@@ -571,6 +573,8 @@ class Runs(list):
     def frame(self, topic: str, columns: list[str] | None = None, ok_only: bool = True) -> pd.DataFrame:
         """One tidy DataFrame of `topic` over every run: run_id, the run's parameters (typed), t, then the
         topic's columns (all, or `columns`). Runs without the topic are left out; units in `.attrs["units"]`."""
+        import pandas as pd
+
         parts, units = [], {}
         for run in self:
             if (ok_only and not run.ok) or topic not in run.topic_names:

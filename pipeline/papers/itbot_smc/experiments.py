@@ -97,22 +97,22 @@ def log_run(log: RunWriter, setup: Setup, execute: DictConfig, law: str, run: Cl
     t, q, qd = run.t[fine], run.q[fine], run.qd[fine]
     q_d, qd_d, qdd_d = setup.reference(t)
     joints = list(JOINTS)
-    log.log_series("/joint_state", t, name=joints, position=q, velocity=qd, effort=run.tau[fine])
-    log.log_series("/joint_state/measured", t, name=joints, position=run.q_measured[fine],
+    log.log_series("/joint_state", t, units="rad", name=joints, position=q, velocity=qd, effort=run.tau[fine])
+    log.log_series("/joint_state/measured", t, units="rad", name=joints, position=run.q_measured[fine],
                    velocity=run.qd_measured[fine])
-    log.log_series("/reference", t, name=joints, position=q_d, velocity=qd_d, acceleration=qdd_d)
+    log.log_series("/reference", t, units="rad", name=joints, position=q_d, velocity=qd_d, acceleration=qdd_d)
     error = q_d - q
-    log.log_series("/tracking_error", t, name=joints, error=error, norm=np.linalg.norm(error, axis=1))
+    log.log_series("/tracking_error", t, units="rad", name=joints, error=error, norm=np.linalg.norm(error, axis=1))
     hand_d, hand = fk(links, q_d), fk(links, q)
-    log.log_series("/reference/hand", t, name=list(HAND_AXES), position=hand_d)
+    log.log_series("/reference/hand", t, units="m", name=list(HAND_AXES), position=hand_d)
     hand_error = hand_d - hand
-    log.log_series("/tracking_error/hand", t, name=list(HAND_AXES), error=hand_error,
+    log.log_series("/tracking_error/hand", t, units="m", name=list(HAND_AXES), error=hand_error,
                    norm=np.linalg.norm(hand_error, axis=1))
     force, zeros = run.hand_force, np.zeros((len(run.t), 1))
     log.log_series("/wrench", run.t, frame_id="base", name=["hand"], force_x=force[:, :1], force_y=force[:, 1:],
                    force_z=zeros, torque_x=zeros, torque_y=zeros, torque_z=zeros)
-    log.log_series("/command", run.t, kind="torque", name=joints, value=run.tau)
-    log.log_series("/sliding_variable", run.t, schemas.Scalars, name=joints, value=run.v)
+    log.log_series("/command", run.t, units="rad", kind="torque", name=joints, value=run.tau)
+    log.log_series("/sliding_variable", run.t, schemas.Scalars, units="rad/s", name=joints, value=run.v)  # v = ė + λe
     log.log_series("/compute_time", run.t, name=[law], seconds=run.controller_s[:, None], calls=[1])
     tf = slice(None, None, _stride(execute.tf_dt, setup.period))
     frames = frames_in_world(setup, run.q[tf], run.t[tf])
@@ -230,9 +230,11 @@ def reaching_time(cfg: DictConfig) -> list[Case]:
                          reaching.nsmerl_time_eq21(v0, K, phi, power, 0.0)])
         # one record per |v(0)|, 1 ms apart on the log's time axis (a study, not a trajectory)
         log.log_series("/reaching_time", np.arange(len(rows)) * 1e-3, schemas.Scalars, name=list(STUDY_FIELDS),
-                       value=np.array(rows))
+                       units=["rad/s"] + ["s"] * (len(STUDY_FIELDS) - 1), value=np.array(rows))
         bracket = (float(sc.v0_min), float(sc.v0_max))
+        # the threshold (27) and the crossovers are values of |v(0)|; α scales |v|^p in exp(−α|v|^p)
         log.log("/reaching_time/summary", 0.0, schemas.Scalars,
+                units=["rad/s", "rad/s", "rad/s", "rad/s^2", "1", f"(rad/s)^-{p:g}", "1", "1"],
                 name=["threshold", "crossover", "crossover_no_switching", "K", "phi", "alpha", "p", "power"],
                 value=[reaching.proposition_threshold(power), reaching.crossover(g, bracket, switching=True),
                        reaching.crossover(g, bracket, switching=False), K, phi, alpha, p, power])

@@ -377,7 +377,7 @@ def compute_time(cfg: DictConfig) -> list[Case]:
             simulate_all()
         model, case, k = combo
         dimensions = nmpc_of(cfg, arm, model, k, int(case != "no-obstacle"), case == "obstacle-height").dimensions()
-        log.log("/nmpc/problem", 0.0, schemas.Scalars, name=list(dimensions),
+        log.log("/nmpc/problem", 0.0, schemas.Scalars, units="1", name=list(dimensions),
                 value=[float(v) for v in dimensions.values()])
         offset = 0.0
         for index, tr, obstacles, untimed in results[combo]:

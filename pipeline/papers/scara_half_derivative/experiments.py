@@ -120,7 +120,7 @@ def log_closed_loop(log: RunWriter, cfg: DictConfig, arm: Arm, motion: Motion, r
     log.log_series("/joint_state", t, units="rad", name=list(JOINTS), position=q, velocity=qd, effort=held)
     log.log_series("/tracking_error", t, units=EXTERNAL_UNITS, field_units={"norm": "m"}, name=list(EXTERNAL),
                    error=error, norm=np.linalg.norm(error[:, :3], axis=1))
-    log.log_series("/command", t_tau[command], units="N m", kind="torque", name=list(JOINTS), value=tau[command])
+    log.log_series("/command", t_tau[command], units="rad", kind="torque", name=list(JOINTS), value=tau[command])
     log.log("/closed_loop/indexes", float(run.t[-1]), Indexes, **indexes(arm, motion, run, cfg.system.control.dt))
     if np.isfinite(run.controller_s).all():   # a batch times no single controller
         log.log_series("/compute_time", run.t_control, name=[law], seconds=run.controller_s[:, None], calls=[1])
