@@ -35,15 +35,16 @@ KgSize = schemas.define(
 )
 KgSearch = schemas.define(
     "KgSearch", "One A* query on one graph (kg, grid: the plain C-grid, tonly: the T-space voxels only). μ is in "
-    "m^dims (dims = 2 planar, 3 spatial); costs in the metric's own unit; h_start: the heuristic at the start, "
-    "optimal_cost: the cheapest path's cost (Dijkstra, KG only); lengths of the vertex path (q_i first) in m "
-    "(task) and rad (joint); min_base_distance_m: closest approach of P_w to the base axis (z); collision_free: "
-    "the joint path interpolated every dense_step is clear of every obstacle.",
+    "m^dims (dims = 2 planar: m^2, 3 spatial: m^3; declared where logged); costs in the metric's own unit (cspace: "
+    "rad, tspace: m, manipulability: m^(2+dims), manipulability-admissible: m^(1+dims)); h_start: the heuristic "
+    "at the start, optimal_cost: the cheapest path's cost (Dijkstra, KG only); lengths of the vertex path (q_i "
+    "first) in m (task) and rad (joint); min_base_distance_m: closest approach of P_w to the base axis (z); "
+    "collision_free: the joint path interpolated every dense_step is clear of every obstacle.",
     query="int64 1", graph="string", metric="string", found="bool", reason="string", vertices="int64 1",
     expanded="int64 1", met="int64 1", expansions="int64 1", explored_pct="double %", path_vertices="int64 1",
     cost="double metric's unit", h_start="double metric's unit", optimal_cost="double metric's unit",
-    t_length_m="double m", c_length_rad="double rad", max_step_rad="double rad", min_mu="double m^dims",
-    mean_mu="double m^dims", min_base_distance_m="double m", collision_free="bool", min_clearance_m="double m",
+    t_length_m="double m", c_length_rad="double rad", max_step_rad="double rad", min_mu="double q",
+    mean_mu="double q", min_base_distance_m="double m", collision_free="bool", min_clearance_m="double m",
     seconds="double s",
 )
 MAX_QUERY_TRIES = 1000   # random start/goal draws per wanted pair before the scene is declared too cluttered
@@ -205,10 +206,16 @@ def path_record(world: World, scene: Scene, joints: np.ndarray | None, plan: Pla
     return record
 
 
-def log_records(log: RunWriter, topic: str, records: list[dict], spacing: float = 1e-3) -> None:
+def mu_unit(arm: RegionalArm) -> str:
+    """The unit of μ = sqrt(|J Jᵀ|) of the positional Jacobian (m per rad in each of `task_dims` rows)."""
+    return f"m^{arm.task_dims}"
+
+
+def log_records(log: RunWriter, topic: str, records: list[dict], arm: RegionalArm, spacing: float = 1e-3) -> None:
     """One KgSearch message per record, `spacing` s apart on the log's time axis (queries are a sequence)."""
     columns = {k: np.array([r[k] for r in records]) for k in records[0]}
-    log.log_series(topic, np.arange(len(records)) * spacing, KgSearch, **columns)
+    log.log_series(topic, np.arange(len(records)) * spacing, KgSearch,
+                   field_units={"min_mu": mu_unit(arm), "mean_mu": mu_unit(arm)}, **columns)
 
 
 # -- E1: Table 1 and Sec. 3.2 ------------------------------------------------------------------------------------
@@ -242,7 +249,7 @@ def table1(cfg: DictConfig) -> list[Case]:
         # Sec. 3.2.1: the branching factor of the Moore grid, counted on a 3^dim grid, and |jv| at C_res = π
         dims = list(sc.branching_dims)
         degree = [int(np.bincount(kgraph.moore_edges((3,) * d).ravel()).max()) for d in dims]
-        log.log("/kg/branching", 0.0, schemas.Scalars, name=[f"b.dim{d}" for d in dims] + ["jv.c_res_pi"],
+        log.log("/kg/branching", 0.0, schemas.Scalars, units="1", name=[f"b.dim{d}" for d in dims] + ["jv.c_res_pi"],
                 value=[*degree, len(kgraph.joint_values(-math.pi, math.pi, math.pi))])
 
     return [Case("table1", simulate)]
@@ -251,7 +258,7 @@ def table1(cfg: DictConfig) -> list[Case]:
 # -- E2, E3: searches (benchmarks) ---------------------------------------------------------------------------------
 
 
-def _scene_record(world: World, scene: Scene) -> tuple[list[str], list[float]]:
+def _scene_record(world: World, scene: Scene) -> tuple[list[str], list[float], list[str]]:
     # the grid's mask is made (and timed) when first asked for, before its time is read
     values = {"kg.vertices": world.kg.size, "kg.edges": len(world.kg.edges), "kg.blocked": scene.blocked_kg.sum(),
               "kg.components": kgraph.components(world.kg.size, world.kg.edges),
@@ -260,7 +267,8 @@ def _scene_record(world: World, scene: Scene) -> tuple[list[str], list[float]]:
               "tonly.blocked": scene.blocked_tonly.sum(), "kg.build_seconds": world.build_seconds,
               "kg.check_seconds": scene.check_seconds["kg"], "grid.check_seconds": scene.check_seconds["grid"],
               "mu_max": world.mu_max}
-    return list(values), [float(v) for v in values.values()]
+    units = ["s" if name.endswith("_seconds") else mu_unit(world.arm) if name == "mu_max" else "1" for name in values]
+    return list(values), [float(v) for v in values.values()], units
 
 
 def benchmark_case(cfg: DictConfig, arm_name: str, boxes: Boxes, seed: int):
@@ -271,8 +279,8 @@ def benchmark_case(cfg: DictConfig, arm_name: str, boxes: Boxes, seed: int):
     def simulate(log: RunWriter) -> None:
         world = world_of(cfg, arm_name)
         scene = scene_of(cfg, world, boxes, arm_name)
-        names, values = _scene_record(world, scene)
-        log.log("/kg/scene", 0.0, schemas.Scalars, name=names, value=values)
+        names, values, units = _scene_record(world, scene)
+        log.log("/kg/scene", 0.0, schemas.Scalars, units=units, name=names, value=values)
         queries = random_queries(cfg, world, scene, int(sc.pairs), seed)
         graphs = {"kg": (world.kg_planner, scene.blocked_kg, world.kg.q, list(sc.metrics)),
                   "grid": (world.grid_planner, scene.blocked_grid, world.grid.q, list(sc.baseline))}
@@ -290,10 +298,11 @@ def benchmark_case(cfg: DictConfig, arm_name: str, boxes: Boxes, seed: int):
             if sc.tspace_only:
                 plan, joints = world.tonly.plan(query, scene.blocked_tonly)
                 records.append(path_record(world, scene, joints, plan, "tonly", world.tonly.space.size, k, step))
-        log_records(log, "/kg/search", records)
+        log_records(log, "/kg/search", records, world.arm)
         n = world.arm.n
         names = [f"q_start.joint{j + 1}" for j in range(n)] + [f"goal.{a}" for a in "xyz"[: world.arm.task_dims]]
         log.log_series("/kg/query", np.arange(len(queries)) * 1e-3, schemas.Scalars, name=names,
+                       units=["rad"] * n + ["m"] * world.arm.task_dims,
                        value=np.array([np.r_[q.q_start, q.goal] for q in queries]))
         seconds: dict[str, list[float]] = {}
         for r in records:
@@ -337,8 +346,9 @@ def showcase_case(cfg: DictConfig, arm_name: str, boxes: Boxes, query: Query, me
         q_goal, reached = ex.ik_newton(arm, joints[-1], query.goal)
         waypoints = np.vstack([joints, q_goal[None]]) if reached else joints
         record = path_record(world, scene, joints, plan, graph, size, 0, math.radians(cfg.search.dense_step_deg))
-        log_records(log, "/kg/search", [record])
+        log_records(log, "/kg/search", [record], arm)
         log.log("/kg/goal", 0.0, schemas.Scalars, name=["ik_reached", "ik_error_m", "mu_max"],
+                units=["bool", "m", mu_unit(arm)],
                 value=[float(reached), float(np.linalg.norm(arm.position(q_goal) - query.goal)), world.mu_max])
 
         ref = ex.timed_reference(waypoints, e.dt, e.speed, e.accel_fraction, e.settle)
@@ -353,6 +363,7 @@ def showcase_case(cfg: DictConfig, arm_name: str, boxes: Boxes, query: Query, me
         dims = arm.task_dims
         vertex_ids = plan.path if graph == "kg" else np.arange(len(path_q))
         log.log_series("/kg/path", t_path, schemas.Scalars,
+                       units=["1", *["rad"] * arm.n, *["m"] * dims, mu_unit(arm)],
                        name=["vertex", *(f"q.joint{j + 1}" for j in range(arm.n)), *(f"pos.{a}" for a in "xyz"[:dims]),
                              "mu"],
                        value=np.column_stack([vertex_ids, path_q, arm.position(path_q), arm.manipulability(path_q)]))
@@ -364,6 +375,7 @@ def showcase_case(cfg: DictConfig, arm_name: str, boxes: Boxes, query: Query, me
             state[scene.blocked_kg] = VERTEX_STATES["colliding"]
             kg = world.kg
             log.log_series("/kg/vertices", np.zeros(kg.size), schemas.Scalars,
+                           units=[*["m"] * dims, *["rad"] * arm.n, mu_unit(arm), "1", "1"],
                            name=[*(f"pos.{a}" for a in "xyz"[:dims]), *(f"q.joint{j + 1}" for j in range(arm.n)),
                                  "mu", "members", "state"],
                            value=np.column_stack([kg.pos, kg.q, world.kg_planner.space.mu, kg.members, state]))
@@ -395,19 +407,20 @@ def log_execution(log: RunWriter, cfg: DictConfig, world: World, checker: Mujoco
     q_ref, qd_ref = (x[every] for x in ex.padded(ref, n_all))
     if not np.isfinite(q).all():
         raise SimulationFailed("the servoed arm's state is not finite")
-    log.log_series("/joint_state", times, name=names, position=q, velocity=qd, effort=tau)
-    log.log_series("/reference", times, name=names, position=q_ref, velocity=qd_ref)
-    log.log_series("/command", times, kind="torque", name=names, value=tau)
+    # every joint of the DH arms is revolute
+    log.log_series("/joint_state", times, units="rad", name=names, position=q, velocity=qd, effort=tau)
+    log.log_series("/reference", times, units="rad", name=names, position=q_ref, velocity=qd_ref)
+    log.log_series("/command", times, units="rad", kind="torque", name=names, value=tau)
     err = q_ref - q
-    log.log_series("/tracking_error", times, name=names, error=err, norm=np.linalg.norm(err, axis=1))
+    log.log_series("/tracking_error", times, units="rad", name=names, error=err, norm=np.linalg.norm(err, axis=1))
     axes = list("xyz"[: arm.task_dims])
     p_err = arm.position(q_ref[:, : arm.n]) - arm.position(q[:, : arm.n])
-    log.log_series("/tracking_error/pw", times, name=axes, error=p_err, norm=np.linalg.norm(p_err, axis=1))
+    log.log_series("/tracking_error/pw", times, units="m", name=axes, error=p_err, norm=np.linalg.norm(p_err, axis=1))
     if checker is not None:
         executed = checker.clearance(q[:, : arm.n])
         reference = checker.clearance(q_ref[:, : arm.n])
         labels = [f"{kind}.{o}" for kind in ("executed", "reference") for o in checker.obstacle_names]
-        log.log_series("/clearance", times, schemas.Scalars, name=[*labels, "executed.min", "reference.min"],
+        log.log_series("/clearance", times, schemas.Scalars, units="m", name=[*labels, "executed.min", "reference.min"],
                        value=np.column_stack([executed, reference, executed.min(axis=1), reference.min(axis=1)]))
     tf = slice(None, None, max(1, round(e.tf_dt / e.dt)))
     t_tf = (ref.times + e.dt)[tf]
