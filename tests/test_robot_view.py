@@ -202,6 +202,7 @@ PAPER_RUNS = {
     "forrest-biped": ("walking", ["system.walk.duration=0.6", "scenario.window=[0.2,0.6]",
                                   "scenario.lipm_zmp_lags=[0.0]"], "traditional", True),
     "dyad-triad-synthesis": ("four-bar", ["scenario.leg_duration=0.1"], "replay-1to5", True),
+    "itbot-smc": ("tracking", ["system.reference.period=2.5"], "smc-mujoco", False),
 }
 
 
