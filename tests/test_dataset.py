@@ -182,6 +182,8 @@ def test_every_export_stage_exports_an_experiment_of_the_pipeline():
     from .conftest import ROOT
 
     variables = {k: v for block in yaml.safe_load((ROOT / "dvc.yaml").read_text())["vars"] for k, v in block.items()}
-    assert variables["datasets"] and set(variables["datasets"]) <= set(variables["experiments"])
-    for key, item in variables["datasets"].items():
-        assert key == f"{item['slug']}-{item['name']}" and item["module"] == item["slug"].replace("-", "_")
+    staged = {f"{v['slug']}/{v['name']}" for v in variables["experiments"].values()}
+    assert variables["datasets"]
+    for slug, item in variables["datasets"].items():  # one export stage per paper, of its own experiments
+        assert item["module"] == slug.replace("-", "_")
+        assert all(e in staged and e.startswith(f"{slug}/") for e in item["experiments"].split())

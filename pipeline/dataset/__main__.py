@@ -2,6 +2,7 @@
 
     python -m pipeline.dataset ur5-ik-fsm/singular-paths              -> data/datasets/ur5-ik-fsm/singular-paths/
     python -m pipeline.dataset ur5-ik-fsm/singular-paths ur5-ik-fsm/random-paths --out data/datasets/ur5-both
+    python -m pipeline.dataset --each ur5-ik-fsm/singular-paths ur5-ik-fsm/random-paths   -> a dataset each
     python -m pipeline.dataset --runs data/runs/gripper-force-control/force-error-surface --out /tmp/surface
     python -m pipeline.dataset ur5-ik-fsm/singular-paths --fps 100 --license cc0-1.0
 
@@ -27,6 +28,8 @@ def parse(argv: list[str]) -> argparse.Namespace:
     parser.add_argument("--runs", type=Path, action="append", default=[], metavar="DIR",
                         help="a directory of run files (a sweep, episodes); repeatable")
     parser.add_argument("--out", type=Path, help="dataset folder (default data_dir/datasets/<slug>/<name>)")
+    parser.add_argument("--each", action="store_true",
+                        help="one dataset per experiment, each in its default folder (one process for many)")
     parser.add_argument("--data-dir", type=Path, default=Path("data"), help="where runs are read (default data)")
     parser.add_argument("--fps", type=int, help=f"frames per second (default: the log rate, at most {DEFAULT_FPS})")
     parser.add_argument("--license", default=DEFAULT_LICENSE,
@@ -35,6 +38,8 @@ def parse(argv: list[str]) -> argparse.Namespace:
     args = parser.parse_args(argv)
     if not args.experiments and not args.runs:
         parser.error("name an experiment (SLUG/NAME) or a --runs directory")
+    if args.each and (args.runs or args.out):
+        parser.error("--each exports experiments to their own folders: give no --runs or --out")
     if args.fps is not None and not 1 <= args.fps <= MAX_FPS:
         parser.error(f"--fps={args.fps} must be between 1 and {MAX_FPS}")
     if not 0 <= args.workers <= 64:
@@ -61,16 +66,17 @@ def main(argv: list[str]) -> int:
             hint = f": run it first, python -m pipeline experiment={source.experiment}" if source.experiment else ""
             print(f"error: no runs at {source.runs}{hint}", file=sys.stderr)
             return 2
-    out = args.out
-    if out is None:
-        if len(args.experiments) != 1 or args.runs:
-            print("error: several sources make one dataset: say where with --out DIR", file=sys.stderr)
-            return 2
-        out = args.data_dir / "datasets" / args.experiments[0]
+    if args.each:
+        jobs = [([source], args.data_dir / "datasets" / e) for source, e in zip(sources, args.experiments, strict=True)]
+    elif args.out is None and (len(args.experiments) != 1 or args.runs):
+        print("error: several sources make one dataset: say where with --out DIR (or --each)", file=sys.stderr)
+        return 2
+    else:
+        jobs = [(sources, args.out or args.data_dir / "datasets" / args.experiments[0])]
     interrupts.install()
     start = time.perf_counter()
     try:
-        written = export(sources, out, args.fps, args.license, args.workers)
+        written = [path for group, out in jobs for path in export(group, out, args.fps, args.license, args.workers)]
     except ExportError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
