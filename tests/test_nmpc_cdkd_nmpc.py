@@ -113,6 +113,7 @@ def test_compute_time_runs_on_the_kinematic_plant(data_dir):
     runs = [read_run(p) for p in run_files(data_dir / "runs/nmpc-cdkd/compute-time")]
     assert len(runs) == 2 and all(r.ok for r in runs), [r.status for r in runs]
     assert "effort" not in " ".join(runs[0]["/joint_state"].columns)  # a kinematic plant has no torques
+    assert {"/robot_description", "/joint_states"} <= set(runs[0].topic_names)  # the arm drawn all the same
 
 
 # -- Table 3's probes ---------------------------------------------------------------------------------------

@@ -9,7 +9,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from pipeline.core import markers, schemas
 from pipeline.core.experiment import Case
-from pipeline.core.runlog import RunWriter, seconds_to_ns
+from pipeline.core.runlog import MODEL_ATTACHMENT, RunWriter, seconds_to_ns
 from pipeline.core.timing import log_timings, time_calls
 from pipeline.papers.nmpc_cdkd import kinematics as kin
 from pipeline.papers.nmpc_cdkd import planning
@@ -379,6 +379,9 @@ def compute_time(cfg: DictConfig) -> list[Case]:
         dimensions = nmpc_of(cfg, arm, model, k, int(case != "no-obstacle"), case == "obstacle-height").dimensions()
         log.log("/nmpc/problem", 0.0, schemas.Scalars, units="1", name=list(dimensions),
                 value=[float(v) for v in dimensions.values()])
+        _, first, obstacles, _ = results[combo][0]  # the arm drawn (moves of a case have the same obstacles)
+        log.attach(MODEL_ATTACHMENT, model_xml(arm, cfg.system.plant, cfg.system.dt, first.q[0], obstacles.radii),
+                   "application/xml")
         offset = 0.0
         for index, tr, obstacles, untimed in results[combo]:
             log_trajectory(log, arm, tr, combo[0], obstacles, ["obstacle"], offset - float(tr.t[0]), index, untimed)
