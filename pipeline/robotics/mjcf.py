@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pipeline.core.experiment import Rule
 from pipeline.robotics.dh import DH
 
 
@@ -127,6 +128,17 @@ def with_servo_gains(build: Callable[[np.ndarray, np.ndarray], str], q0: np.ndar
     mujoco.mj_fullM(model, data, inertia)
     m, w = np.diag(inertia), 2 * np.pi * bandwidth_hz
     return build(m * w * w, 2 * damping_ratio * m * w)
+
+
+# What a config of an IK-then-servo experiment (servo_rollout) must satisfy between its time steps.
+SERVO_RULES = (
+    Rule(("execute.dt", "scenario.ik_dt"), lambda dt, ik_dt: dt <= ik_dt,
+         "execute.dt={0:g} s must not exceed scenario.ik_dt={1:g} s: the servo runs at least as often as the IK"),
+    Rule(("execute.log_dt", "execute.dt"), lambda log_dt, dt: log_dt >= dt,
+         "execute.log_dt={0:g} s is shorter than the physics step execute.dt={1:g} s"),
+    Rule(("execute.log_dt", "scenario.duration"), lambda log_dt, T: log_dt <= T / 10,
+         "execute.log_dt={0:g} s leaves fewer than 10 samples of the {1:g} s path"),
+)
 
 
 def servo_rollout(xml: str, q_ref: np.ndarray, qd_ref: np.ndarray, times: np.ndarray, *, moving_start: bool = False

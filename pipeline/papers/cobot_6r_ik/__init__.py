@@ -23,6 +23,7 @@ from pipeline.core.experiment import Budget, Length, OneOf, Range, Rule
 from pipeline.papers.cobot_6r_ik import ik
 from pipeline.papers.cobot_6r_ik.ik import DEFAULT, Diagnostics, Tolerances
 from pipeline.papers.cobot_6r_ik.kinematics import CRX10IAL, Geometry, cayley, cayley_params, fk, twin, wrap
+from pipeline.robotics.mjcf import SERVO_RULES
 
 __all__ = ["CRX10IAL", "DEFAULT", "Diagnostics", "Geometry", "Tolerances", "cayley", "cayley_params", "fk",
            "ik_all", "ik_batch", "ik_diagnose", "twin", "wrap"]
@@ -86,12 +87,7 @@ LIMITS: dict[str, Range | OneOf] = {
     "scenario.q_deg": Range(ge=-360, le=360), "scenario.q_start_deg": Range(ge=-360, le=360),
 }
 RULES = (
-    Rule(("execute.dt", "scenario.ik_dt"), lambda dt, ik_dt: dt <= ik_dt,
-         "execute.dt={0:g} s must not exceed scenario.ik_dt={1:g} s: the servo runs at least as often as the IK"),
-    Rule(("execute.log_dt", "execute.dt"), lambda log_dt, dt: log_dt >= dt,
-         "execute.log_dt={0:g} s is shorter than the physics step execute.dt={1:g} s"),
-    Rule(("execute.log_dt", "scenario.duration"), lambda log_dt, T: log_dt <= T / 10,
-         "execute.log_dt={0:g} s leaves fewer than 10 samples of the {1:g} s path"),
+    *SERVO_RULES,
     Rule(("scenario.reference_poses", "scenario.poses"), lambda n_ref, n: n_ref <= n,
          "scenario.reference_poses={0:g} exceeds scenario.poses={1:g}"),
 )

@@ -15,10 +15,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, Budget, Length, OneOf, Range, Rule, Text
+from pipeline.core.experiment import NON_NEGATIVE, POSITIVE, Budget, Length, OneOf, Range, Text
 from pipeline.papers.ur5_ik_fsm import ik
 from pipeline.papers.ur5_ik_fsm.ik import PAPER, Conventions
 from pipeline.papers.ur5_ik_fsm.kinematics import UR5, Geometry, det_j, fk, jacobian, shoulder_term
+from pipeline.robotics.mjcf import SERVO_RULES
 
 __all__ = ["PAPER", "UR5", "Conventions", "Geometry", "det_j", "fk", "ik_all", "ik_batch", "ik_fsm",
            "ik_min_displacement", "jacobian", "shoulder_term"]
@@ -83,14 +84,9 @@ LIMITS = {
     "execute.bandwidth_hz": Range(gt=0, le=100), "execute.damping_ratio": POSITIVE, "scenario.near_gap": NON_NEGATIVE,
     "scenario.wrist.length": POSITIVE, "scenario.shoulder.length": POSITIVE, "scenario.elbow.length": POSITIVE,
 }
-RULES = (
-    Rule(("execute.dt", "scenario.ik_dt"), lambda dt, ik_dt: dt <= ik_dt,
-         "execute.dt={0:g} s must not exceed scenario.ik_dt={1:g} s: the servo runs at least as often as the IK"),
-    Rule(("execute.log_dt", "execute.dt"), lambda log_dt, dt: log_dt >= dt,
-         "execute.log_dt={0:g} s is shorter than the physics step execute.dt={1:g} s"),
-    Rule(("execute.log_dt", "scenario.duration"), lambda log_dt, T: log_dt <= T / 10,
-         "execute.log_dt={0:g} s leaves fewer than 10 samples of the {1:g} s path"),
-)
+RULES = SERVO_RULES
+
+
 def _path_steps(c) -> float:
     return len(c.scenario.paths) * len(c.scenario.algorithms) * len(c.scenario.crossings) * c.scenario.duration \
         / c.execute.dt
