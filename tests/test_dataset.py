@@ -179,11 +179,10 @@ def test_the_official_lerobot_class_loads_the_export(tmp_path):
 
 
 def test_every_export_stage_exports_an_experiment_of_the_pipeline():
-    from .conftest import ROOT
+    from analysis.core.report import simulate_args, stage_vars
 
-    variables = {k: v for block in yaml.safe_load((ROOT / "dvc.yaml").read_text())["vars"] for k, v in block.items()}
-    staged = {f"{v['slug']}/{v['name']}" for v in variables["experiments"].values()}
-    assert variables["datasets"]
-    for slug, item in variables["datasets"].items():  # one export stage per paper, of its own experiments
-        assert item["module"] == slug.replace("-", "_")
-        assert all(e in staged and e.startswith(f"{slug}/") for e in item["experiments"].split())
+    exports = {slug: v["datasets"] for slug, v in stage_vars().items() if v["datasets"]}
+    assert exports
+    for slug, datasets in exports.items():   # at most one export stage per paper, of its own experiments
+        assert list(datasets) == ["lerobot"]
+        assert all(e in simulate_args() and e.startswith(f"{slug}/") for e in datasets["lerobot"].split())

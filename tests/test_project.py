@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import yaml
 
+from analysis.core.report import simulate_args, stage_vars
 from analysis.core.stages import PAPERS_DIR, analyzed_slugs, paper_package
 from analysis.core.targets import Tolerance, judge, load_targets
 from analysis.core.units import convert
@@ -17,12 +18,13 @@ from .conftest import ROOT
 
 
 def test_every_experiment_is_a_dvc_stage_and_has_code():
-    dvc = yaml.safe_load((ROOT / "dvc.yaml").read_text())
-    staged = {f"{v['slug']}/{v['name']}" for v in dvc["vars"][0]["experiments"].values()}
-    assert staged == set(available_experiments())
-    analysed = {slug: v["module"] for slug, v in dvc["vars"][1]["papers"].items()}  # one analyze stage per paper
-    assert analysed == {slug: module_name(slug) for slug in analyzed_slugs()}
-    assert set(analysed) == {e.split("/")[0] for e in available_experiments()}
+    papers = stage_vars()   # one stages/<slug>/ per paper: its dvc.yaml links to the shared stage definitions
+    assert set(papers) == set(analyzed_slugs()) == {e.split("/")[0] for e in available_experiments()}
+    for slug, values in papers.items():
+        assert values["slug"] == slug and values["module"] == module_name(slug)
+        link = ROOT / "stages" / slug / "dvc.yaml"
+        assert link.is_symlink() and link.resolve() == (ROOT / "stages" / "paper-stages.yaml").resolve()
+    assert set(simulate_args()) == set(available_experiments())
     for experiment in available_experiments():
         slug, name = experiment.split("/")
         assert name in paper_module(slug).EXPERIMENTS

@@ -315,10 +315,10 @@ def test_paper_declarations(slug):
     text = (package / "paper.yaml").read_text() + "".join(targets["note"]) + "".join(
         p.read_text() for p in package.glob("*.py"))
     assert "spec §" not in text
-    # every band is justified in paper.yaml and is a disclosed sweep (`-m`) in dvc.yaml
+    # every band is justified in paper.yaml and is a disclosed sweep (`-m`) in its DVC stages
     bands = {b["experiment"]: b for b in info.get("bands") or []}
     assert set(targets["band"]) - {""} <= set(bands), f"{slug}: bands not declared in paper.yaml"
-    sweeps = report._dvc_args()
+    sweeps = report.simulate_args()
     for name, b in bands.items():
         assert all(str(b.get(k, "")).strip() for k in ("parameter", "range", "why")), f"{slug}: band {name}"
         assert sweeps.get(f"{slug}/{name}", "").startswith("-m "), f"{slug}: band {name} is not a -m sweep"

@@ -142,18 +142,20 @@ def counts(evaluated: pd.DataFrame) -> dict[str, dict[str, int]]:
 
 
 @cache
-def _dvc_args() -> dict[str, str]:
-    """experiment id -> the extra arguments of its simulate stage in dvc.yaml (a sweep's grid)."""
-    path = ROOT / "dvc.yaml"
-    if not path.is_file():
-        return {}
-    entries = yaml.safe_load(path.read_text())["vars"][0]["experiments"]
-    return {f"{e['slug']}/{e['name']}": e.get("args", "") for e in entries.values()}
+def stage_vars() -> dict[str, dict]:
+    """slug -> the vars of its DVC stages (stages/<slug>/experiments.yaml): `experiments`, each name with the extra
+    arguments of its simulate stage (a sweep's grid), and `datasets`, what its export stage writes."""
+    return {p.parent.name: yaml.safe_load(p.read_text()) for p in sorted((ROOT / "stages").glob("*/experiments.yaml"))}
+
+
+def simulate_args() -> dict[str, str]:
+    """experiment id -> the extra arguments of its simulate stage (a sweep's grid)."""
+    return {f"{slug}/{name}": args for slug, v in stage_vars().items() for name, args in v["experiments"].items()}
 
 
 def commands(experiment_id: str) -> tuple[str, str]:
     """The commands that regenerate an experiment's runs, then its metrics and figures (and the report)."""
-    args = _dvc_args().get(experiment_id, "")
+    args = simulate_args().get(experiment_id, "")
     multirun = "-m " if args.startswith("-m ") else ""
     simulate = f"python -m pipeline {multirun}experiment={experiment_id} {args.removeprefix('-m ')}".strip()
     return simulate, f"python -m analysis experiment={experiment_id}"
