@@ -21,7 +21,7 @@ def main() -> None:
     from pipeline.core.checks import BadInput, preflight
     from pipeline.core.cli import register_help_resolver, runs_nothing, split_args
 
-    # Hydra wants its flags before all overrides; accept them anywhere (dvc.yaml appends -m).
+    # Hydra wants its flags before all overrides; accept them anywhere (a DVC stage appends -m).
     flags, overrides = split_args(sys.argv[1:])
     sys.argv[1:] = flags + overrides
 

@@ -23,7 +23,7 @@ def test_experiments_to_report(data_dir):
         ["experiment=gripper-force-control/pick-and-place"],
         ["experiment=gripper-force-control/steady-state", "scenario.grasps=3", "scenario.duration=0.15"],
     )
-    for args in runs:   # sweep_dir=data_dir: the band sweeps beside the default runs, as dvc.yaml runs them
+    for args in runs:   # sweep_dir=data_dir: the band sweeps beside the default runs, as their DVC stages run them
         proc = run_cli("pipeline", *args, f"data_dir={data_dir}", f"sweep_dir={data_dir}", "progress=false")
         assert proc.returncode == 0, proc.stderr
     proc = run_cli("analysis", f"data_dir={data_dir}")

@@ -34,6 +34,22 @@ def test_every_experiment_is_a_dvc_stage_and_has_code():
         assert text != "(no description)" and "\n" not in text and len(text) <= 140, experiment
 
 
+
+def test_dvc_reads_every_paper_s_stages():
+    """DVC itself resolves the linked stage files with each paper's vars: one simulate stage per experiment, one
+    analyze stage per paper, one export stage per paper with datasets, and the report."""
+    import subprocess
+    import sys
+
+    listed = subprocess.run([sys.executable, "-m", "dvc", "stage", "list", "--all", "--name-only"], cwd=ROOT,
+                            capture_output=True, text=True, check=True).stdout.split()
+    expected = {"report"}
+    for slug, values in stage_vars().items():
+        stages = f"stages/{slug}/dvc.yaml"
+        expected |= {f"{stages}:simulate@{name}" for name in values["experiments"]} | {f"{stages}:analyze"}
+        expected |= {f"{stages}:export@{key}" for key in values["datasets"]}
+    assert sorted(listed) == sorted(expected)
+
 @pytest.mark.parametrize("slug", analyzed_slugs())
 def test_targets_files_are_valid_and_point_at_real_experiments(slug):
     targets = load_targets(PAPERS_DIR / module_name(slug) / "targets.csv")

@@ -31,7 +31,7 @@ Each paper has `analysis/papers/<module>/targets.csv` with one row per reported 
   (`run` is a run id, or the id of an aggregate the analysis writes, e.g. `surface`); `metric` is in SI;
   `unit` is the paper's, and the pipeline value is converted to it for the comparison
 - `band`: empty, or the name of an experiment of the same paper whose runs are a disclosed sweep of a parameter
-  the paper omits (a Hydra `-m` sweep in dvc.yaml; see "Sensitivity bands" below)
+  the paper omits (a Hydra `-m` sweep in its DVC stages; see "Sensitivity bands" below)
 - `note`: the rule, assumption or evidence behind the row; for a miss or close, the evidence for its cause
 - `qualitative` targets compare a metric that is 1 when the stated rule holds, 0 when not
 
@@ -46,8 +46,8 @@ Statuses (STATUS_MEANING says each in one sentence; the report prints them):
 Statuses of a `consistency` row: agrees / disagrees (the same rule as match / miss), or not run.
 
 Sensitivity bands. Where a reported number depends on a parameter the paper omits, we sweep it:
-- the sweep is an experiment of its own (`<name>` in dvc.yaml with `args: "-m key=a,b,c ..."`); its run ids are
-  `<case>__k=v,…` (pipeline/core/runner.py: run_id);
+- the sweep is an experiment of its own (`<name>: "-m key=a,b,c ..."` in stages/<slug>/experiments.yaml); its run
+  ids are `<case>__k=v,…` (pipeline/core/runner.py: run_id);
 - the target names that experiment in `band`. Its band is [min, max] of the target's `metric` (converted to the
   target's unit) over every row of the band experiment whose run id is the target's `run` or starts with
   `<run>__` (band_runs), the rows of failed runs left out: the ok runs, and the aggregates the analysis writes

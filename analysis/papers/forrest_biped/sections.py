@@ -123,7 +123,7 @@ def robustness_section(r: pd.DataFrame, w: pd.DataFrame | None) -> Section:
                              "band max [%]": band[a][1], "paper [%]": _paper(a),
                              "paper inside the band": band[a][0] <= _paper(a) <= band[a][1]} for a in ("x", "y")])
     return Section("Robustness of the shares: a sweep over what the paper does not give",
-                   "A Hydra multirun (dvc.yaml) over the CP gain k ∈ {2.5, 10} 1/s (default 5), a common scale of "
+                   "A Hydra multirun (its DVC stage) over the CP gain k ∈ {2.5, 10} 1/s (default 5), a common scale of "
                    "every PD gain ∈ {0.5, 2} (default 1) and the simulated robot's mass: Table 4's 32.51 kg or Table "
                    "1's 35.1 kg (×1.0797) under the controller's Table 4 model, with the default stance-foot setting. "
                    "Ranges fixed before the runs (paper.yaml). The band is [min, max] of the share over the jobs. 'Not "
