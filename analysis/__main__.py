@@ -15,7 +15,7 @@ import difflib
 import sys
 from pathlib import Path
 
-KEYS = {"experiment": None, "data_dir": "data", "stage": "all"}
+KEYS = {"experiment": None, "data_dir": "data", "stage": "all", "workers": "0"}
 STAGES = ("all", "analyze", "report")
 CONF_DIR = Path(__file__).resolve().parent / "conf"
 
@@ -34,6 +34,8 @@ def parse(overrides: list[str]) -> dict[str, str | None]:
             raise ValueError(f"unknown key '{key}'" + (f" (did you mean '{hint[0]}'?)" if hint else
                                                        f"; keys: {', '.join(KEYS)}"))
         args[key] = None if value == "null" else value
+    if not (args["workers"] or "").isdigit() or int(args["workers"]) > 64:
+        raise ValueError(f"workers={args['workers']} must be a whole number from 0 (one per core) to 64")
     if args["stage"] not in STAGES:
         raise ValueError(f"stage={args['stage']} must be one of {', '.join(STAGES)}")
     known = available_experiments()
@@ -78,7 +80,7 @@ def main() -> None:
     def task(cfg: DictConfig) -> None:
         from analysis.core.stages import run
 
-        code = run(Path(cfg.data_dir), cfg.experiment, cfg.stage)
+        code = run(Path(cfg.data_dir), cfg.experiment, cfg.stage, int(cfg.workers))
         if code:
             raise SystemExit(code)
 

@@ -16,6 +16,7 @@ paper figure they regenerate and their place on the page (analysis/core/report.p
 
 from __future__ import annotations
 
+import functools
 import importlib
 import sys
 from pathlib import Path
@@ -27,7 +28,7 @@ from analysis.core import report
 from analysis.core.figures import Figures
 from analysis.core.metrics import read_metrics, write_metrics
 from analysis.core.targets import evaluate, load_targets, self_check
-from pipeline.core import files
+from pipeline.core import files, parallel
 from pipeline.core.experiment import available_experiments, module_name
 from pipeline.core.runlog import Run, read_run, run_files
 
@@ -115,24 +116,32 @@ def write_report(data_dir: Path) -> tuple[Path, list[str]]:
     return report.write_index(report_dir, report.index_context(pages)), problems
 
 
-def run(data_dir: Path, experiment: str | None, stage: str) -> int:
+def _analyze_or_say_why(experiment_id: str, data_dir: Path) -> tuple[Path | None, str | None]:
+    try:
+        return analyze(experiment_id, data_dir), None
+    except Exception as err:  # a bug in one paper's analysis: say so, analyse the others
+        return None, f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''}"
+
+
+def run(data_dir: Path, experiment: str | None, stage: str, workers: int = 0) -> int:
     """Analyze the experiments that have runs (`experiment`: one `<slug>/<name>`, every experiment of a paper
-    `<slug>`, or None: all), then write the report; 1 if nothing could be analysed, an
-    experiment's analysis failed (the others are still analysed) or the report's self-check found a problem
-    (the report is still written, with every problem named on stderr)."""
+    `<slug>`, or None: all) on `workers` processes (0: one per core), then write the report; 1 if nothing could
+    be analysed, an experiment's analysis failed (the others are still analysed) or the report's self-check found
+    a problem (the report is still written, with every problem named on stderr)."""
     one = experiment is not None and "/" in experiment
     experiments = [experiment] if one else [e for e in available_experiments() if e.split("/")[0] in analyzed_slugs()
                                             and (experiment is None or e.split("/")[0] == experiment)]
     failed = 0
     if stage in ("analyze", "all"):
+        for slug in sorted({e.split("/")[0] for e in experiments}):
+            paper_package(slug)   # imported once, before the workers fork
+        outcomes = parallel.imap(functools.partial(_analyze_or_say_why, data_dir=data_dir), experiments, workers,
+                                 chunksize=1)
         analysed = 0
-        for experiment_id in experiments:
-            try:
-                out = analyze(experiment_id, data_dir)
-            except Exception as err:  # a bug in one paper's analysis: say so, analyse the others
+        for experiment_id, (out, error) in zip(experiments, outcomes, strict=True):
+            if error:
                 failed += 1
-                print(f"error: the analysis of {experiment_id} failed: {type(err).__name__}: "
-                      f"{str(err).splitlines()[0] if str(err) else ''}"[:280], file=sys.stderr)
+                print(f"error: the analysis of {experiment_id} failed: {error}"[:280], file=sys.stderr)
                 continue
             if out is None:
                 if one:
