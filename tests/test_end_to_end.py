@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import pandas as pd
 
+from analysis.core import stages
 from pipeline.core.runlog import read_run, run_files
 
 from .conftest import run_cli
@@ -53,6 +54,12 @@ def test_pipeline_to_report(data_dir):
         assert "spec §" not in html
     index = (report / "index.html").read_text()
     assert all(s in index for s in ("match", "close", "not run", "misses still open", "self-consistency"))
+
+    # the experiments were analysed side by side (one process per core): one process gives the same metrics
+    metrics = {p.name: pd.read_parquet(p) for p in sorted((data_dir / "metrics/ur5-ik-fsm").glob("*.parquet"))}
+    assert len(metrics) == 3 and stages.run(data_dir, "ur5-ik-fsm", "analyze", workers=1) == 0
+    for name, frame in metrics.items():
+        pd.testing.assert_frame_equal(pd.read_parquet(data_dir / "metrics/ur5-ik-fsm" / name), frame)
 
     run = read_run(run_files(data_dir / "runs/ur5-ik-fsm/singular-paths")[0])
     assert run.metadata["slug"] == "ur5-ik-fsm" and run.metadata["git_revision"]
