@@ -13,7 +13,7 @@ import yourdfpy
 
 from pipeline.papers.src_joint import Chain, RollingChain
 from pipeline.papers.src_joint.revolute import chain_xml, hinge_angles, hinge_names
-from pipeline.papers.src_joint.rolling import trolley_rates
+from pipeline.papers.src_joint.rolling import exp_so3, trolley_rates
 from pipeline.robotics.urdf import describe
 
 RADIUS = 0.034   # m, Table II
@@ -94,3 +94,17 @@ def test_the_aligned_start_is_all_zeros():
     radii = np.full(4, RADIUS)
     plant = RollingChain(radii)
     assert np.array_equal(hinge_angles(plant.tangent, plant.relative, radii), np.zeros(12))
+
+
+def test_a_trajectory_keeps_its_azimuths_continuous():
+    """Over time the azimuths are unwrapped: the same poses as sample by sample (up to 2π), without 2π steps.
+    The states: equal spheres rolled 0.4 rad about an axis that turns twice round the normal (reachable by
+    rolling: the constraint is integrable, reachability.py)."""
+    radii = np.full(2, RADIUS)
+    turn = np.linspace(0.0, 4 * np.pi, 400)
+    r = 0.4 * np.stack([np.cos(turn), np.sin(turn), np.zeros_like(turn)], axis=-1)[:, None]
+    tangent, relative = exp_so3(r), exp_so3(2 * r)
+    qpos = hinge_angles(tangent, relative, radii)
+    each = np.stack([hinge_angles(T, R, radii) for T, R in zip(tangent, relative, strict=True)])
+    assert qpos.shape == (400, 4) and np.allclose(np.angle(np.exp(1j * (qpos - each))), 0.0, atol=1e-12)
+    assert np.allclose(qpos[:, 0] - qpos[0, 0], turn, atol=1e-12)   # the azimuth follows the axis round twice

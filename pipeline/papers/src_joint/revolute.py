@@ -68,16 +68,18 @@ def _rgba(color: tuple) -> str:
 
 
 def hinge_angles(tangent: np.ndarray, relative: np.ndarray, radii) -> np.ndarray:
-    """qpos (..., 4n) of `chain_xml` for rolling states: ^{B_{i-1}}R_{P_i} `tangent` and ^{B_{i-1}}R_{B_i}
-    `relative`, each (..., n, 3, 3). The azimuth and the lower roll are the contact normal's polar angles in
-    B_{i-1}; the upper roll follows by the radius ratio (module docstring). Only P_i's normal counts: its turn
-    about the normal (a trolley's frame carried round a loop) moves no body. Raises ValueError for a state the
-    four hinges cannot draw."""
+    """qpos of `chain_xml` for rolling states ^{B_{i-1}}R_{P_i} `tangent` and ^{B_{i-1}}R_{B_i} `relative`: (4n,)
+    for states (n, 3, 3), (N, 4n) for a trajectory (N, n, 3, 3), whose azimuths are unwrapped in time. The azimuth
+    and the lower roll are the contact normal's polar angles in B_{i-1}; the upper roll follows by the radius
+    ratio (module docstring). Only P_i's normal counts: its turn about the normal (a trolley's frame carried
+    round a loop) moves no body. Raises ValueError for a state the four hinges cannot draw."""
     radii = np.asarray(radii, dtype=float)
     normal = tangent[..., :, 2]                           # Rz(φ) Rx(α) e_z = (sin α sin φ, −sin α cos φ, cos α)
     sin_alpha = np.hypot(normal[..., 0], normal[..., 1])
     alpha = np.arctan2(sin_alpha, normal[..., 2])
     phi = np.where(sin_alpha > 0, np.arctan2(normal[..., 0], -normal[..., 1]), 0.0)   # at the pole: any φ
+    if phi.ndim > 1:   # a trajectory: no 2π steps in the plotted azimuths
+        phi = np.unwrap(phi, axis=0)
     beta = alpha * radii[:-1] / radii[1:]                 # α = (l_i / l_{i-1}) β
     axis = np.stack([np.cos(phi), np.sin(phi), np.zeros_like(phi)], axis=-1)
     departure = np.abs(exp_so3((alpha + beta)[..., None] * axis) - relative).max(initial=0.0)
