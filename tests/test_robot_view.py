@@ -183,7 +183,8 @@ def test_view_writes_under_data_views(tmp_path):
 
 
 # -- every articulated paper: one short run each, simulated in-process ----------------------------------------
-# (experiment, overrides that shorten it, the case drawn, whether the run's own /tf names the model's bodies)
+# slug (or slug/experiment where a paper has more than one robot): (experiment, overrides that shorten it, the
+# case drawn, whether the run's own /tf names the model's bodies)
 PAPER_RUNS = {
     "ur5-ik-fsm": ("singular-paths", ["scenario.paths=[wrist]", "scenario.duration=0.5"], "wrist-near-alg1", False),
     "curve-discretization": ("snake-gait", ["scenario.duration=0.2", "scenario.joints=6"], "lateral-undulation", False),
@@ -195,6 +196,8 @@ PAPER_RUNS = {
                                          "scenario.controllers=[kd]"], None, False),
     "spherical-terrain": ("physics-check", ["system.duration=0.5", "scenario.classes=[rt]"], None, False),
     "src-joint": ("joint-model", ["scenario.duration=0.5", "scenario.plants=[mujoco]"], "mujoco-corrected", False),
+    "src-joint/avoid-obstacles": ("avoid-obstacles", ["scenario.duration=1.0", "scenario.cases=[avoid]"], "avoid",
+                                  True),
     "admittance-assembly": ("mujoco-crosscheck", ["scenario.cases=[spatial]", "scenario.runs=[static]",
                                                   "scenario.admittance=isotropic"], None, False),
     "srs-collision-avoidance": ("circle", ["scenario.cases=[avoid]", "system.task.samples=40"], None, False),
@@ -203,6 +206,7 @@ PAPER_RUNS = {
                                   "scenario.lipm_zmp_lags=[0.0]"], "traditional", True),
     "dyad-triad-synthesis": ("four-bar", ["scenario.leg_duration=0.1"], "replay-1to5", True),
     "itbot-smc": ("tracking", ["system.reference.period=2.5"], "smc-mujoco", False),
+    "kinematic-graph": ("search", ["scenario.scenes=[obstacle]"], "obstacle-cspace", False),
 }
 
 
@@ -214,9 +218,10 @@ def paper_runs(tmp_path_factory):
 
     made: dict[str, object] = {}
 
-    def run(slug: str):
-        if slug not in made:
-            name, overrides, case_id, _ = PAPER_RUNS[slug]
+    def run(key: str):
+        if key not in made:
+            name, overrides, case_id, _ = PAPER_RUNS[key]
+            slug = key.split("/")[0]
             cfg = compose_config([f"experiment={slug}/{name}", *overrides])
             cases = resolve(f"{slug}/{name}").fn(cfg)
             case = next(c for c in cases if case_id is None or c.id == case_id)
@@ -224,8 +229,8 @@ def paper_runs(tmp_path_factory):
             with RunWriter(path, {"run_id": case.id, "slug": slug}) as w:
                 case.simulate(w)
                 w.close("ok")
-            made[slug] = read_run(path)
-        return made[slug]
+            made[key] = read_run(path)
+        return made[key]
 
     return run
 

@@ -56,11 +56,12 @@ def test_runs_carry_the_replay_and_convert_to_rerun(data, tmp_path):
     from analysis.view import convert
 
     run = read_run(data / "runs" / "src-joint" / "avoid-obstacles" / "avoid.mcap")
-    assert {"/tf", "/markers", "/joint_state", "/command", "/clearance", "/clearance/mujoco",
-            "/compute_time"} <= set(run.topic_names)
-    markers = run["/markers"]
-    assert markers.filter(like="spheres.0.size.x").iloc[0].tolist() == pytest.approx([0.068] * 5)
-    assert "scene.xml" in run.attachments and run.metadata["status"] == "ok"
+    assert {"/tf", "/markers", "/joint_state", "/command", "/clearance", "/clearance/mujoco", "/compute_time",
+            "/robot_description", "/joint_states"} <= set(run.topic_names)
+    assert run["/markers"].filter(like="cylinders.1.size.z").iloc[0].tolist() == [0.6]   # the two bars
+    urdf = run["/robot_description"]["data"].iloc[0]   # the chain: B_0 … B_4 from its four-hinge MJCF
+    assert urdf.count('<sphere radius="0.034"/>') == 5 and urdf.count('type="continuous"') == 16
+    assert {"scene.xml", "model.xml"} <= set(run.attachments) and run.metadata["status"] == "ok"
     out = convert(run.path, tmp_path / "avoid.rrd")
     assert out.stat().st_size > 100_000
     joint = read_run(data / "runs" / "src-joint" / "joint-model" / "mujoco-corrected.mcap")

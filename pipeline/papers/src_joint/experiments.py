@@ -13,6 +13,7 @@ from pipeline.core import markers, schemas
 from pipeline.core.experiment import Case
 from pipeline.core.runlog import RunWriter, SimulationFailed
 from pipeline.papers.src_joint import reachability as reach
+from pipeline.papers.src_joint import revolute
 from pipeline.papers.src_joint import trolley as tr
 from pipeline.papers.src_joint.ik import Bars, Damper, DamperQP, IkGains, IkResult, solve_ik
 from pipeline.papers.src_joint.manipulator import (
@@ -32,7 +33,8 @@ from pipeline.papers.src_joint.physics import (
     roll_exactly,
     roll_in_mujoco,
 )
-from pipeline.papers.src_joint.rolling import RollingChain
+from pipeline.papers.src_joint.revolute import BASE_COLOR, LINK_COLOR
+from pipeline.papers.src_joint.rolling import RollingChain, exp_so3
 from pipeline.robotics.transforms import quaternion_wxyz
 
 AXES = ["x", "y", "z"]
@@ -93,7 +95,7 @@ def log_spheres(log: RunWriter, bodies: list[str], radii, colors: list[tuple]) -
     log.write("/markers", 0, schemas.SceneUpdate(entities=markers.spheres(bodies, radii, colors)))
 
 
-BASE_COLOR, LINK_COLOR, GHOST_COLOR = (0.55, 0.6, 0.7, 1.0), (0.9, 0.6, 0.2, 1.0), (0.2, 0.5, 0.9, 0.35)
+GHOST_COLOR = (0.2, 0.5, 0.9, 0.35)
 
 
 # -- E1: the joint model against physics (Sec. V-A, Figs. 8-10) -----------------------------------------------
@@ -204,9 +206,22 @@ def joint_names(n: int, fields) -> list[str]:
     return [f"j{i + 1}.{f}" for i in range(n) for f in fields]
 
 
+def log_chain(log: RunWriter, t: np.ndarray, frames: np.ndarray, tangent: np.ndarray, relative: np.ndarray,
+              radii: np.ndarray, target: np.ndarray) -> None:
+    """The chain in 3-D: the paper's frames B_0 … B_n and the target on /tf, and the robot drawn from its
+    four-hinge MJCF (model.xml, revolute.py) by the hinge angles of the rolling states ^{B_{i-1}}R_{P_i}
+    `tangent` and ^{B_{i-1}}R_{B_i} `relative` (each (N, n, 3, 3))."""
+    bodies = [f"B{i}" for i in range(len(radii))]
+    log.log_transforms(t, "world", [*bodies, "target"],
+                       np.concatenate([frames, np.broadcast_to(target, (len(t), 1, 4, 4))], axis=1))
+    log.attach("model.xml", revolute.chain_xml(radii), "application/xml")
+    log.log_robot(t, revolute.hinge_angles(tangent, relative, radii))
+
+
 def log_manipulator(log: RunWriter, trace: Trace, r_desired: np.ndarray, q_desired: np.ndarray,
                     sphere_radius: float) -> dict[str, np.ndarray]:
-    """Joint, trolley and wheel states, end-effector errors and frames of one run; returns the arrays."""
+    """Joint, trolley and wheel states, end-effector errors and the chain in 3-D of one run; returns the
+    arrays."""
     a = trace.arrays()
     t, frames = a["times"], a["frames"]
     n = frames.shape[1] - 1
@@ -228,11 +243,8 @@ def log_manipulator(log: RunWriter, trace: Trace, r_desired: np.ndarray, q_desir
     R_err = rotation(q_desired) @ np.swapaxes(frames[:, -1, :3, :3], -1, -2)     # R_d Rᵀ
     log.log_series("/tracking_error/orientation", t, units="rad", name=EULER, error=euler_xyz(R_err),
                    norm=angle_of(R_err))
-    target = poses(r_desired, rotation(q_desired))
-    bodies = [f"B{i}" for i in range(n + 1)]
-    log.log_transforms(t, "world", [*bodies, "target"],
-                       np.concatenate([frames, np.broadcast_to(target, (len(t), 1, 4, 4))], axis=1))
-    log_spheres(log, bodies, [sphere_radius] * (n + 1), [BASE_COLOR] + [LINK_COLOR] * n)
+    log_chain(log, t, frames, a["tangent"], a["relative"], np.full(n + 1, sphere_radius),
+              poses(r_desired, rotation(q_desired)))
     return a
 
 
@@ -369,11 +381,8 @@ def reach_floor(cfg: DictConfig) -> list[Case]:
                                                            "eps_z_max")], value=rows)
         if best is not None:   # the closest exact-rolling pose, to look at beside the target
             pos, rot = reach.fk(best.rotvecs[None], radius)
-            bodies = [f"B{i}" for i in range(n + 1)]
-            target_pose = poses(r_desired, rotation(unit_quaternion(printed)))
-            log.log_transforms(np.zeros(1), "world", [*bodies, "target"],
-                               np.concatenate([poses(pos, rot), target_pose[None, None]], axis=1))
-            log_spheres(log, bodies, [radius] * (n + 1), [BASE_COLOR] + [LINK_COLOR] * n)
+            log_chain(log, np.zeros(1), poses(pos, rot), exp_so3(best.rotvecs[None]), exp_so3(2 * best.rotvecs[None]),
+                      radii, poses(r_desired, rotation(unit_quaternion(printed))))
             log.log("/joint_state", 0.0, units="rad", name=joint_names(n, AXES),
                     position=best.rotvecs.ravel().tolist())
 
