@@ -10,6 +10,7 @@ import pandas as pd
 import pytest
 import yaml
 
+from pipeline.core import stages
 from pipeline.core.checks import BadInput, preflight
 from pipeline.core.runlog import RunWriter, read_run, read_runs, run_files
 
@@ -30,6 +31,9 @@ def test_an_experiment_exports_to_a_lerobot_dataset_with_units_and_a_card(data_d
     assert proc.returncode == 0, proc.stderr
     proc = run_cli("pipeline.dataset", "ur5-ik-fsm/singular-paths", "--data-dir", str(data_dir), "--fps", "100")
     assert proc.returncode == 0, proc.stderr
+    journal = {e["stage"]: e for e in stages.read(data_dir)}   # both stages' times, for the benchmark
+    assert set(journal) == {"simulate", "export"} and journal["export"]["experiment"] == "ur5-ik-fsm"
+    assert journal["export"]["wall_s"] > 0 and journal["simulate"]["first_step_s"] > 0
     root = data_dir / "datasets/ur5-ik-fsm/singular-paths"
     info = json.loads((root / "meta/info.json").read_text())
     assert info["codebase_version"] == "v3.0" and info["fps"] == 100 and info["total_episodes"] == 4

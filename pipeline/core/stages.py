@@ -1,8 +1,8 @@
 """How long each stage process took, so the slowest stages of a pipeline run are visible.
 
-Every `python -m pipeline` and `python -m analysis` process that succeeds appends one JSON line to
-`<data_dir>/.stages.jsonl` when it ends: what it ran, its wall and CPU time, and (simulate) how long it took
-from process start to the first simulated step. Lines are short and appended in one write, so processes
+Every `python -m pipeline`, `python -m analysis` and `python -m pipeline.dataset` process that succeeds appends
+one JSON line to `<data_dir>/.stages.jsonl` when it ends: what it ran, its wall and CPU time, and (simulate) how
+long it took from process start to the first simulated step. Lines are short and appended in one write, so processes
 running at once do not interleave them. `python -m pipeline.benchmark stages` prints the newest line of each
 stage, slowest first.
 """

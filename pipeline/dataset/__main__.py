@@ -86,6 +86,10 @@ def main(argv: list[str]) -> int:
     for path in written:
         print(f"wrote {path}", file=sys.stderr)
     print(f"exported in {time.perf_counter() - start:.2f} s", file=sys.stderr)
+    from pipeline.core import stages
+
+    stages.record(args.data_dir, "export", ",".join(sorted({e.split("/")[0] for e in args.experiments}))
+                  or ",".join(str(d) for d in args.runs))
     return 0
 
 
