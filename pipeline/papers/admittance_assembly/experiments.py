@@ -210,6 +210,23 @@ def log_trajectory(log: RunWriter, g: PegInHole, tr: insertion.Trajectory, speed
                                           (tr.lam[keep] > 0).sum(axis=1), two_point, tr.gap[keep].min(axis=1)]))
 
 
+def log_scene(log: RunWriter, g: PegInHole, A: np.ndarray, tr: insertion.Trajectory, dt: float,
+                       tf_dt: float) -> None:
+    """The scene of a quasi-static run on /markers: the peg and the hole (the cross-check's model), and at the
+    instants of the peg's /tf (log_pose) each loaded candidate's point with its constraint force λ·n (N, on the
+    peg) as an arrow, as the MuJoCo runs draw theirs."""
+    from pipeline.papers.admittance_assembly import mujoco_peg
+
+    log.write("/markers", 0, schemas.SceneUpdate(entities=mujoco_peg.drawing(g, A)))
+    every = max(1, round(tf_dt / dt))
+    lam = tr.lam[::every]
+    c = geometry.contacts(g, tr.R[::every], tr.p[::every])
+    loaded = lam > 0
+    log.log_contacts(tr.t[::every], [c.point[i, on] for i, on in enumerate(loaded)],
+                     [lam[i, on, None] * c.normal[i, on] for i, on in enumerate(loaded)], CONTACT_SCALE,
+                     diameter=0.0008)
+
+
 def insertion_runs(cfg: DictConfig) -> list[Case]:
     sc = cfg.scenario
 
@@ -222,6 +239,7 @@ def insertion_runs(cfg: DictConfig) -> list[Case]:
         log.metadata["outcome"] = tr.outcome
         log_trajectory(log, g, tr, cfg.system.nominal_speed, max(1, round(sc.log_dt / sc.dt)))
         log_pose(log, tr.t, tr.R, tr.p, sc.dt, sc.tf_dt)
+        log_scene(log, g, A, tr, sc.dt, sc.tf_dt)
         log.attach("admittance.yaml", admittance_yaml(g, A, kind), "application/yaml")
 
     return [Case(f"{case}-{kind}-{trial}", lambda log, c=case, k=kind, i=trial: simulate(log, c, k, i))
