@@ -30,7 +30,8 @@ def twist_units(dofs: list[str]) -> list[str]:
     return ["m" if d.startswith("v") else "rad" for d in dofs]
 SAMPLE_DT = 1e-3  # s: samples that are not a trajectory (configurations, admittances) are logged 1 ms apart
 NEAR_GAP = 1e-4   # m: a MuJoCo contact is attributed to the nearest candidate within this gap
-CONTACT_SCALE = 0.005  # m/N: MuJoCo's contact forces (up to ~7 N) drawn 5 mm per newton beside the 5 cm peg
+CONTACT_SCALE = 0.005  # m/N, contact forces drawn 5 mm per newton beside the 5 cm peg, one scale for both models
+                       # (MuJoCo's and the quasi-static: the two-point state squeezes the peg with 5-45 N a side)
 
 
 # -- configuration -> model -----------------------------------------------------------------------------
@@ -210,8 +211,7 @@ def log_trajectory(log: RunWriter, g: PegInHole, tr: insertion.Trajectory, speed
                                           (tr.lam[keep] > 0).sum(axis=1), two_point, tr.gap[keep].min(axis=1)]))
 
 
-def log_scene(log: RunWriter, g: PegInHole, A: np.ndarray, tr: insertion.Trajectory, dt: float,
-                       tf_dt: float) -> None:
+def log_scene(log: RunWriter, g: PegInHole, A: np.ndarray, tr: insertion.Trajectory, dt: float, tf_dt: float) -> None:
     """The scene of a quasi-static run on /markers: the peg and the hole (the cross-check's model), and at the
     instants of the peg's /tf (log_pose) each loaded candidate's point with its constraint force λ·n (N, on the
     peg) as an arrow, as the MuJoCo runs draw theirs."""
