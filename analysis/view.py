@@ -79,6 +79,8 @@ def _log_entity(rec: rr.RecordingStream, entity, drawn: dict[str, set[str]]) -> 
     # every archetype carries the frame itself: a child entity does not inherit its parent's CoordinateFrame,
     # and geometry without one hangs off no named frame (Rerun then draws nothing)
     frame = rr.CoordinateFrame(entity.frame_id or "world")
+    if entity.metadata and path not in drawn:   # e.g. the scale of force arrows (m/N), shown with the entity
+        rec.log(path, rr.AnyValues(**{kv.key: kv.value for kv in entity.metadata}), static=True)
     present = {kind for kind in _PRIMITIVES if getattr(entity, kind)}
     for kind in drawn.get(path, set()) - present:
         rec.log(f"{path}/{kind}", rr.Clear(recursive=False))

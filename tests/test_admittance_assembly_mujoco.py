@@ -3,6 +3,9 @@ MuJoCo on a static two-contact case, and the three experiments run end to end in
 
 from __future__ import annotations
 
+import shutil
+import subprocess
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -11,7 +14,7 @@ from pipeline.core.runlog import read_run, run_files
 from pipeline.papers.admittance_assembly import design, geometry, mujoco_peg, quasistatic
 from pipeline.papers.admittance_assembly.geometry import PegInHole
 
-from .conftest import run_cli
+from .conftest import ENV, run_cli
 
 pytest.importorskip("mujoco")
 
@@ -119,3 +122,59 @@ def test_experiments_run_end_to_end_into_the_report(data_dir):
     metrics = pd.read_parquet(data_dir / "metrics/admittance-assembly/mujoco-crosscheck.parquet")
     static = metrics[metrics["run_id"] == runs["planar-static"].run_id].set_index("metric")["value"]
     assert static["force_error.c1.max"] < 0.01 and static["force_error.c2.max"] < 0.01  # N, at 1 N
+
+
+def test_quasi_static_insertion_draws_its_contact_forces(tmp_path):
+    """A quasi-static run draws the peg, the hole and, at the peg's /tf instants, an arrow λ·n (at the scale its
+    metadata names, m/N) from each loaded candidate's point, as the model computes them; the arrows add up to
+    the logged contact force; analysis.view turns them into Rerun arrows in the world frame."""
+    from mcap.reader import make_reader
+    from mcap_protobuf.decoder import DecoderFactory
+
+    from analysis import view
+    from pipeline.core.checks import compose_config
+    from pipeline.core.experiment import resolve
+    from pipeline.core.runlog import RunWriter
+    from pipeline.papers.admittance_assembly import experiments, insertion
+
+    name = "admittance-assembly/insertion"
+    cfg = compose_config([f"experiment={name}", "scenario.cases=[spatial]", "scenario.admittances=[isotropic]",
+                          "scenario.trials=1", "scenario.duration=1.2"])
+    [case] = resolve(name).fn(cfg)
+    path = tmp_path / "run.mcap"
+    with RunWriter(path, {"run_id": case.id, "slug": "admittance-assembly"}) as w:
+        case.simulate(w)
+        w.close("ok")
+    sc = cfg.scenario
+    g, A = experiments.peg_in_hole(cfg, "spatial"), experiments.admittance(cfg, "spatial", "isotropic")
+    R0, p0, _ = geometry.chart_poses(g, experiments.start_coords(cfg, "spatial", 1)[0])
+    tr = insertion.insert(g, A, R0[0], p0[0], speed=cfg.system.nominal_speed, dt=sc.dt, duration=sc.duration,
+                          active_gap=sc.active_gap)
+    force = read_run(path)["/wrench"].filter(regex=r"^force_[xyz]")
+    with open(path, "rb") as f:
+        updates = [(m.log_time, u) for _, _, m, u in make_reader(f, decoder_factories=[DecoderFactory()])
+                   .iter_decoded_messages(topics=["/markers"])]
+    assert {e.id for e in updates[0][1].entities} == {"geoms/world", "geoms/peg"}   # the hole's walls, the peg
+    drawn = [(t, e) for t, u in updates for e in u.entities if e.id == "contacts"]
+    assert len(drawn) == len(tr.t[::round(sc.tf_dt / sc.dt)])
+    pressed = 0
+    for t_ns, entity in drawn[::4]:
+        k = round(t_ns / 1e9 / sc.dt)
+        loaded = tr.lam[k] > 0
+        c = geometry.contacts(g, tr.R[k], tr.p[k])
+        scale = float(next(kv.value for kv in entity.metadata if kv.key == "force_scale").removesuffix(" m/N"))
+        origins, vectors = view._arrow_vectors(entity.arrows)
+        assert np.allclose(origins, c.point[0, loaded], atol=1e-12)
+        assert np.allclose(np.array(vectors) / scale, tr.lam[k, loaded, None] * c.normal[0, loaded], atol=1e-9)
+        assert abs(force.index[k] - tr.t[k]) < 1e-9   # /wrench has every step (log_dt = dt)
+        logged = tr.R[k] @ force.iloc[k].to_numpy()   # body frame -> world
+        assert np.allclose(np.sum(vectors, axis=0) / scale, logged, atol=1e-9 * max(1.0, np.abs(logged).max()))
+        pressed += loaded.sum() >= 2
+    assert pressed >= 3
+    if shutil.which("rerun") is None:
+        pytest.skip("rerun CLI (rerun-sdk) not on PATH")
+    printed = subprocess.run(["rerun", "rrd", "print", str(view.convert(path, tmp_path / "run.rrd"))], check=True,
+                             env=ENV, capture_output=True, text=True, timeout=120).stdout
+    arrows = [line for line in printed.splitlines() if " - /markers/contacts/arrows - " in line]
+    assert arrows and all("Arrows3D:vectors" in line and "CoordinateFrame:frame" in line for line in arrows)
+    assert any(" - /markers/contacts - " in line and "force_scale" in line for line in printed.splitlines())

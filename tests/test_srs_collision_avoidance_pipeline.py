@@ -3,8 +3,10 @@ report on a temporary data_dir, the statuses the reproduction reaches, and what 
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 import pytest
+from scipy.spatial.transform import Rotation
 
 from pipeline.core.checks import compose_config
 from pipeline.core.runlog import read_run
@@ -72,3 +74,45 @@ def test_run_carries_the_scene_and_the_common_topics(data):
     assert "transforms.human1/upper.translation.x" in tf and "transforms.link7.rotation.w" in tf
     scene = run["/markers"].iloc[0]
     assert scene.filter(like="cylinders").notna().any()                   # capsules and cones drawn
+
+
+def test_ablation_run_draws_the_circle_runs_robot_at_its_planned_joints(data):
+    """A planned-only run carries the replay model's URDF (the circle run's), the human arms and the scene; the
+    URDF moved by its /joint_states puts every link on the pipeline's own FK (/tf) and every human link at its
+    capsule's start, along its axis."""
+    import io
+
+    import yourdfpy
+
+    from pipeline.core import robot
+
+    run = read_run(data / "runs" / SLUG / "ablation" / "avoid__system.filter.p=20.mcap")
+    circle = read_run(data / "runs" / SLUG / "circle" / "avoid.mcap")
+    assert {robot.ROBOT_DESCRIPTION, robot.JOINT_STATES, robot.ROBOT_TF, "/markers"} <= set(run.topic_names)
+    assert run.attachments[robot.URDF_ATTACHMENT] == circle.attachments[robot.URDF_ATTACHMENT]
+    urdf = yourdfpy.URDF.load(io.StringIO(run[robot.ROBOT_DESCRIPTION]["data"].iloc[0]), load_meshes=False,
+                              load_collision_meshes=False)
+    states, planned = run[robot.JOINT_STATES], run["/joint_state"]
+    tf = run["/tf"].groupby(level=0).first()   # the fixed world -> base turn comes in a message of its own
+    names = [c.removeprefix("joints.").removesuffix(".name") for c in states.columns if c.endswith(".name")]
+    assert {f"joint{i}" for i in range(1, 8)} <= set(names)
+    humans = [c.removeprefix("transforms.").removesuffix(".translation.x") for c in tf.columns
+              if c.startswith("transforms.human") and c.endswith(".translation.x")]
+    assert len(humans) == 4
+    model = urdf.robot.name
+    for t in states.index[[0, len(states) // 3, -1]]:
+        urdf.update_cfg({n: states.loc[t, f"joints.{n}.position"] for n in names})
+        assert np.allclose([states.loc[t, f"joints.joint{i}.position"] for i in range(1, 8)],
+                           planned.loc[t, [f"position.joint{i}" for i in range(1, 8)]], atol=1e-12)
+        for frame in [*(f"link{i}" for i in range(1, 8)), *humans]:
+            T = urdf.get_transform(f"{model}/{frame.replace('/', '_')}", "world")
+            origin = [tf.loc[t, f"transforms.{frame}.translation.{a}"] for a in "xyz"]
+            assert np.allclose(T[:3, 3], origin, atol=1e-9), (frame, t)
+            w, x, y, z = (tf.loc[t, f"transforms.{frame}.rotation.{a}"] for a in "wxyz")
+            logged = Rotation.from_quat([x, y, z, w]).as_matrix()
+            # the links' frames whole; a human capsule's frame only along its axis (its roll is arbitrary)
+            assert np.allclose(T[:3, :3] if frame.startswith("link") else T[:3, 2],
+                               logged if frame.startswith("link") else logged[:, 2], atol=1e-9), (frame, t)
+    scene = run["/markers"]
+    ids = set(scene.filter(regex=r"^entities\.\d+\.id$").stack())
+    assert {"safety/upper_arm", "safety/forearm", "link4", "p_c"} <= ids

@@ -115,12 +115,13 @@ CONTACT_RGBA = (0.9, 0.1, 0.1, 1.0)
 def contacts(name: str, points: np.ndarray, forces: np.ndarray, scale: float, frame: str = "world",
              color: Sequence[float] = CONTACT_RGBA, diameter: float = 0.004) -> schemas.SceneEntity:
     """Contact points (c, 3) in `frame` as small balls, each with its force (c, 3; N) as an arrow from the
-    point, drawn at `scale` m/N. No contact (c = 0) gives an empty entity: logged under the same `name`, it
-    replaces the previous instant's contacts."""
+    point, drawn at `scale` m/N (said in the entity's metadata, `force_scale`). No contact (c = 0) gives an
+    empty entity: logged under the same `name`, it replaces the previous instant's contacts."""
     points = np.asarray(points, dtype=float).reshape(-1, 3)
     forces = np.asarray(forces, dtype=float).reshape(-1, 3) * scale
     return schemas.SceneEntity(
         frame_id=frame, id=name, frame_locked=True,
+        metadata=[schemas.KeyValuePair(key="force_scale", value=f"{scale:g} m/N")],
         spheres=[_ball(p, diameter, color) for p in points],
         arrows=[_arrow(p, f, color, diameter) for p, f in zip(points, forces, strict=True) if f.any()])
 

@@ -17,6 +17,7 @@ from foxglove_schemas_protobuf.CylinderPrimitive_pb2 import CylinderPrimitive
 from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
 from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
 from foxglove_schemas_protobuf.JointStates_pb2 import JointStates
+from foxglove_schemas_protobuf.KeyValuePair_pb2 import KeyValuePair
 from foxglove_schemas_protobuf.LinePrimitive_pb2 import LinePrimitive
 from foxglove_schemas_protobuf.Point3_pb2 import Point3
 from foxglove_schemas_protobuf.Pose_pb2 import Pose
@@ -191,9 +192,9 @@ def for_topic(topic: str) -> type[Message] | None:
 
 
 __all__ = ["ENTRY", "TOPICS", "UNITS", "ArrowPrimitive", "Color", "CubePrimitive", "CylinderPrimitive",
-           "FrameTransform", "FrameTransforms", "JointStates", "LinePrimitive", "Point3", "Pose", "PosesInFrame",
-           "Quaternion", "SceneEntity", "SceneUpdate", "SpherePrimitive", "TriangleListPrimitive", "Vector3", "define",
-           "derive", "for_topic", "per_second", "stamp", "units_of"]
+           "FrameTransform", "FrameTransforms", "JointStates", "KeyValuePair", "LinePrimitive", "Point3", "Pose",
+           "PosesInFrame", "Quaternion", "SceneEntity", "SceneUpdate", "SpherePrimitive", "TriangleListPrimitive",
+           "Vector3", "define", "derive", "for_topic", "per_second", "stamp", "units_of"]
 
 
 def stamp(t_ns: int) -> timestamp_pb2.Timestamp:

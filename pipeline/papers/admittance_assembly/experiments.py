@@ -30,7 +30,8 @@ def twist_units(dofs: list[str]) -> list[str]:
     return ["m" if d.startswith("v") else "rad" for d in dofs]
 SAMPLE_DT = 1e-3  # s: samples that are not a trajectory (configurations, admittances) are logged 1 ms apart
 NEAR_GAP = 1e-4   # m: a MuJoCo contact is attributed to the nearest candidate within this gap
-CONTACT_SCALE = 0.005  # m/N: MuJoCo's contact forces (up to ~7 N) drawn 5 mm per newton beside the 5 cm peg
+CONTACT_SCALE = 0.005  # m/N, contact forces drawn 5 mm per newton beside the 5 cm peg, one scale for both models
+                       # (MuJoCo's and the quasi-static: the two-point state squeezes the peg with 5-45 N a side)
 
 
 # -- configuration -> model -----------------------------------------------------------------------------
@@ -210,6 +211,22 @@ def log_trajectory(log: RunWriter, g: PegInHole, tr: insertion.Trajectory, speed
                                           (tr.lam[keep] > 0).sum(axis=1), two_point, tr.gap[keep].min(axis=1)]))
 
 
+def log_scene(log: RunWriter, g: PegInHole, A: np.ndarray, tr: insertion.Trajectory, dt: float, tf_dt: float) -> None:
+    """The scene of a quasi-static run on /markers: the peg and the hole (the cross-check's model), and at the
+    instants of the peg's /tf (log_pose) each loaded candidate's point with its constraint force λ·n (N, on the
+    peg) as an arrow, as the MuJoCo runs draw theirs."""
+    from pipeline.papers.admittance_assembly import mujoco_peg
+
+    log.write("/markers", 0, schemas.SceneUpdate(entities=mujoco_peg.drawing(g, A)))
+    every = max(1, round(tf_dt / dt))
+    lam = tr.lam[::every]
+    c = geometry.contacts(g, tr.R[::every], tr.p[::every])
+    loaded = lam > 0
+    log.log_contacts(tr.t[::every], [c.point[i, on] for i, on in enumerate(loaded)],
+                     [lam[i, on, None] * c.normal[i, on] for i, on in enumerate(loaded)], CONTACT_SCALE,
+                     diameter=0.0008)
+
+
 def insertion_runs(cfg: DictConfig) -> list[Case]:
     sc = cfg.scenario
 
@@ -222,6 +239,7 @@ def insertion_runs(cfg: DictConfig) -> list[Case]:
         log.metadata["outcome"] = tr.outcome
         log_trajectory(log, g, tr, cfg.system.nominal_speed, max(1, round(sc.log_dt / sc.dt)))
         log_pose(log, tr.t, tr.R, tr.p, sc.dt, sc.tf_dt)
+        log_scene(log, g, A, tr, sc.dt, sc.tf_dt)
         log.attach("admittance.yaml", admittance_yaml(g, A, kind), "application/yaml")
 
     return [Case(f"{case}-{kind}-{trial}", lambda log, c=case, k=kind, i=trial: simulate(log, c, k, i))

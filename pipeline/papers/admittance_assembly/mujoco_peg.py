@@ -92,6 +92,18 @@ def model_xml(g: PegInHole, A: np.ndarray, s: MujocoSettings) -> str:
 """
 
 
+def drawing(g: PegInHole, A: np.ndarray) -> list:
+    """The peg (in /tf frame `peg`) and the hole's walls (in `world`) of this model as /markers entities: what
+    draws a quasi-static run, which has no MuJoCo model of its own. Only the geometry is drawn, so the contact
+    and time settings are MuJoCo's defaults."""
+    import mujoco
+
+    from pipeline.core import markers
+
+    geometry_only = MujocoSettings(timestep=0.002, mass=1.0, solref=(0.02, 1.0), solimp=(0.9, 0.95, 0.001, 0.5, 2))
+    return markers.mujoco_geoms(mujoco.MjModel.from_xml_string(model_xml(g, A, geometry_only)))
+
+
 class PegSim:
     """The model and its state, with the pose, the body twist and the contact wrench in our conventions."""
 

@@ -36,6 +36,9 @@ LENGTH = Range(gt=0, le=5.0)        # m
 POSITION = Range(ge=-5.0, le=5.0)   # m
 SIGN = OneOf((1, -1))
 TURNS = Range(ge=0, le=1000)        # cycles over a run
+# Beside the robot in Foxglove and Rerun: the replay's joint error, α_f (Fig. 7) and the human points' margins to
+# the safety volume (negative inside: what Algorithm 1 acts on).
+VIEW_PLOTS = ["/tracking_error.norm", "/swivel.alpha_f_rad", "/clearance/volume.distance_m[:]"]
 # Experiments whose compute times are results: their runs have the machine to themselves.
 TIMED = frozenset({"compute-time", "circle"})
 LIMITS = {

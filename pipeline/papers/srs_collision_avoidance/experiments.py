@@ -1,6 +1,6 @@
 """Simulate stage of `srs-collision-avoidance`: the circle task of Sec. 5 with and without avoidance and the
-printed/exact/unfiltered variants, each replayed in MuJoCo (`circle`); the filter pole swept (`ablation`);
-the per-iteration compute time of Algorithm 1 (`compute-time`)."""
+printed/exact/unfiltered variants, each replayed in MuJoCo (`circle`); the filter pole swept (`ablation`, planned
+motion drawn without a replay); the per-iteration compute time of Algorithm 1 (`compute-time`)."""
 
 from __future__ import annotations
 
@@ -220,23 +220,31 @@ def dynamics(cfg: DictConfig) -> mujoco_replay.Dynamics:
                                   damping=tuple(d.damping), torque_limit=tuple(d.torque_limit))
 
 
+def _model(cfg: DictConfig, arms: HumanArms, timestep: float, kp: np.ndarray, kv: np.ndarray) -> str:
+    lengths = np.tile([arms.upper_length, arms.fore_length], len(arms.base))
+    radii = np.tile(arms.radius, len(arms.base))
+    return mujoco_replay.model_xml(geometry(cfg), dynamics(cfg), radii, lengths, timestep=timestep, kp=kp, kv=kv)
+
+
 def replay_model(cfg: DictConfig, arms: HumanArms, q0: np.ndarray) -> str:
     from pipeline.robotics.mjcf import with_servo_gains
 
-    lengths = np.tile([arms.upper_length, arms.fore_length], len(arms.base))
-    radii = np.tile(arms.radius, len(arms.base))
-    g, dyn, rp = geometry(cfg), dynamics(cfg), cfg.replay
+    rp = cfg.replay
+    return with_servo_gains(lambda kp, kv: _model(cfg, arms, rp.dt, kp, kv), q0, rp.bandwidth_hz, rp.damping_ratio)
 
-    def build(kp, kv) -> str:
-        return mujoco_replay.model_xml(g, dyn, radii, lengths, timestep=rp.dt, kp=kp, kv=kv)
 
-    return with_servo_gains(build, q0, rp.bandwidth_hz, rp.damping_ratio)
+def drawing_model(cfg: DictConfig, arms: HumanArms) -> str:
+    """The replay model without its servo (zero gains): what draws a run that is planned, not replayed. Its
+    URDF is the replay's, since a URDF carries no actuators."""
+    zero = np.zeros(len(JOINTS))
+    return _model(cfg, arms, cfg.system.filter.dt, zero, zero)
 
 
 def replay(log: RunWriter, cfg: DictConfig, times: np.ndarray, plan: planner.Plan, capsules: tuple,
-           arms: HumanArms) -> None:
+           arms: HumanArms) -> np.ndarray:
     """Execute the planned joints under the model's joint servo, log what the arm did, and audit the planned
-    clearance with MuJoCo's distance query (at the planned and at the executed joints)."""
+    clearance with MuJoCo's distance query (at the planned and at the executed joints). Returns the executed
+    joints at the planning samples (N, 7)."""
     from scipy.interpolate import CubicSpline
     from scipy.spatial.transform import Rotation
 
@@ -270,35 +278,37 @@ def replay(log: RunWriter, cfg: DictConfig, times: np.ndarray, plan: planner.Pla
                    name=[*XYZ, "rotation"],
                    error=np.column_stack([dp, rotation_angle(desired[:, :3, :3], R_tool)]),
                    norm=np.linalg.norm(dp, axis=1))
-    # link frames of the executed motion at the planning samples
-    at_samples = np.clip(np.rint(times / rp.dt).astype(int) - 1, 0, len(states) - 1)
-    start, end, _ = capsules
-    log_frames(log, times, states[at_samples, 1:8], g, plan.poses, start, end, arms)
-    log.log_robot(times, states[at_samples, 1:8], *mujoco_replay.mocap_poses(start, end))   # humans: mocap
     # MuJoCo's distance query on the same capsules: at the planned joints and at the executed ones
+    executed = states[np.clip(np.rint(times / rp.dt).astype(int) - 1, 0, len(states) - 1), 1:8]
+    start, end, _ = capsules
     names = pair_names(arms)
     planned = mujoco_replay.capsule_distances(xml, plan.q, start, end)
-    executed = mujoco_replay.capsule_distances(xml, states[at_samples, 1:8], start, end)
     log.log_series("/clearance/capsules_mujoco", times, Distances, name=names,
                    distance_m=planned.reshape(len(times), -1))
     log.log_series("/clearance/capsules_replay", times, Distances, name=names,
-                   distance_m=executed.reshape(len(times), -1))
+                   distance_m=mujoco_replay.capsule_distances(xml, executed, start, end).reshape(len(times), -1))
+    return executed
 
 
 def _simulate(log: RunWriter, cfg: DictConfig, case: str, replayed: bool) -> None:
-    """One case: Algorithm 1 over the task, logged; then either the MuJoCo replay (the arm drawn as it moved)
-    or, for the ablation's many runs, the planned joints alone (no scene)."""
+    """One case: Algorithm 1 over the task, logged; then either the MuJoCo replay or, for the ablation's many
+    runs, the planned joints alone. Either way the scene is drawn: the arm and the human arms from the replay
+    model's URDF (at the executed or the planned joints), the safety volume and the collision points."""
     times, plan, points, capsules = plan_case(cfg, case)
-    arms = humans(cfg)
+    arms, g = humans(cfg), geometry(cfg)
     log_plan(log, cfg, times, plan, points, capsules, arms)
     log.log_series("/reference/tool", times, schemas.Reference, units="m", name=XYZ, position=plan.poses[:, :3, 3])
+    log_scene(log, cfg, g)
+    log_collision_points(log, times, plan, cfg.system.filter.dt)
     if replayed:
-        log_scene(log, cfg, geometry(cfg))
-        log_collision_points(log, times, plan, cfg.system.filter.dt)
-        replay(log, cfg, times, plan, capsules, arms)
+        q, model = replay(log, cfg, times, plan, capsules, arms), None   # drawn from the attached model.xml
     else:
-        log.log_series("/joint_state", times, units="rad", name=JOINTS, position=plan.q,
-                       velocity=np.gradient(plan.q, times, axis=0))
+        q, model = plan.q, drawing_model(cfg, arms)
+        log.log_series("/joint_state", times, units="rad", name=JOINTS, position=q,
+                       velocity=np.gradient(q, times, axis=0))
+    start, end, _ = capsules
+    log_frames(log, times, q, g, plan.poses, start, end, arms)
+    log.log_robot(times, q, *mujoco_replay.mocap_poses(start, end), model=model)   # the humans: mocap bodies
 
 
 def circle(cfg: DictConfig) -> list[Case]:
