@@ -8,9 +8,10 @@ polar angle α), the shift (l_{i-1} + l_i) along it (eq. 7), and B_i's orientati
 
 five hinges: the azimuth, the roll on B_{i-1}'s side (the normal's tilt), then intrinsic X-Y-Z angles of B_i
 (`roll_upper`, `lean_upper`, `azimuth_back`). X-Y-Z is chosen for where its singularity lies (γ = ±π/2, B_i's z
-axis along the rolling axis ê = Rz(φ) e_x): as far as can be from every rolled state, whose γ is 0 on a straight
-roll and grows only with the twist that rolling unequal spheres round a curve leaves (the holonomy). At the
-singularity, as at B_{i-1}'s pole (α = 0, any φ), the angles are still exact; only their continuity is lost.
+axis along the rolling axis ê = Rz(φ) e_x): a straight roll, and every state of equal spheres, has γ = 0, as far
+from it as can be; γ grows only with the twist about the normal that rolling unequal spheres round a curve
+leaves (the holonomy). At the singularity, as at B_{i-1}'s pole (α = 0, any φ), the angles are still exact;
+only their continuity is lost.
 
 Equal spheres need four. Eq. (10) puts the tangent plane P_i at ^{B_{i-1}}R_{P_i} = R(q_{i-1,2})ᵀ and eq. (6)
 turns B_i by ^{P_i}R_{B_i} = R(q_{i,1}). Rolling from the aligned start by θ about an axis ê = Rz(φ) e_x of the
