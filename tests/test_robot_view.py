@@ -198,6 +198,8 @@ PAPER_RUNS = {
     "src-joint": ("joint-model", ["scenario.duration=0.5", "scenario.plants=[mujoco]"], "mujoco-corrected", False),
     "src-joint/avoid-obstacles": ("avoid-obstacles", ["scenario.duration=1.0", "scenario.cases=[avoid]"], "avoid",
                                   True),
+    "src-joint/exact": ("joint-model", ["scenario.duration=2.0", "scenario.plants=[exact]"], "exact-corrected", True),
+    "src-joint/eq5-loop": ("reach-floor", ["scenario.loop.side=0.3"], "eq5-loop", True),
     "admittance-assembly": ("mujoco-crosscheck", ["scenario.cases=[spatial]", "scenario.runs=[static]",
                                                   "scenario.admittance=isotropic"], None, False),
     "srs-collision-avoidance": ("circle", ["scenario.cases=[avoid]", "system.task.samples=40"], None, False),

@@ -33,7 +33,6 @@ from pipeline.papers.src_joint.physics import (
     roll_exactly,
     roll_in_mujoco,
 )
-from pipeline.papers.src_joint.revolute import BASE_COLOR, LINK_COLOR
 from pipeline.papers.src_joint.rolling import RollingChain, exp_so3
 from pipeline.robotics.transforms import quaternion_wxyz
 
@@ -95,7 +94,7 @@ def log_spheres(log: RunWriter, bodies: list[str], radii, colors: list[tuple]) -
     log.write("/markers", 0, schemas.SceneUpdate(entities=markers.spheres(bodies, radii, colors)))
 
 
-GHOST_COLOR = (0.2, 0.5, 0.9, 0.35)
+GHOST_COLOR, LITERAL_COLOR = (0.2, 0.5, 0.9, 0.35), (0.7, 0.2, 0.8, 0.35)   # the model; eq. (5) read literally
 
 
 # -- E1: the joint model against physics (Sec. V-A, Figs. 8-10) -----------------------------------------------
@@ -186,14 +185,17 @@ def joint_model(cfg: DictConfig) -> list[Case]:
                            name=["penetration", "normal_force", "friction_force"])
         frames = _joint_pose_frames(plant, model, lower, upper)
         log.log_transforms(t, "world", ["B0", "B1", "B1_model", "P1"], frames)
-        if xml:  # the simulated pair drawn from its MuJoCo model (B1 on its free joint), the model's B1 beside it
+        # the plant drawn as a robot, the model's B1 beside it
+        if xml:  # the simulated pair from its MuJoCo model, B1 on its free joint
             log.log_robot(t, np.concatenate([frames[:, 1, :3, 3], quaternion_wxyz(frames[:, 1, :3, :3])], axis=1))
-            log_spheres(log, ["B1_model"], [upper], [GHOST_COLOR])
             normal_force = plant.contact[:, 1]
             log.log_contacts(t, frames[:, 3, None, :3, 3], (normal_force[:, None] * frames[:, 3, :3, 2])[:, None],
                              CONTACT_SCALE, diameter=0.002)
-        else:
-            log_spheres(log, ["B0", "B1", "B1_model"], [lower, upper, upper], [BASE_COLOR, LINK_COLOR, GHOST_COLOR])
+        else:  # exact rolling by the hinges of its relative state (revolute.py)
+            radii = np.array([lower, upper])
+            log.attach("model.xml", revolute.chain_xml(radii, "src-joint"), "application/xml")
+            log.log_robot(t, revolute.hinge_angles(plant.tangent[:, None], plant.rotation[:, None], radii))
+        log_spheres(log, ["B1_model"], [upper], [GHOST_COLOR])
 
     return [Case(f"{plant}-{variant}", lambda log, p=plant, v=variant: simulate(log, p, v))
             for plant in sc.plants for variant in sc.variants]
@@ -394,10 +396,16 @@ def reach_floor(cfg: DictConfig) -> list[Case]:
         sides = np.repeat(np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]]) * lp.rate, steps, axis=0)
         chains = {mode: Chain(radii[:2], model_form(cfg, joint_update=mode)) for mode in reach.MODES}
         plant = RollingChain(radii[:2])
-        quaternions = np.zeros((len(sides) + 1, 3, 4))
-        for j in range(len(sides) + 1):
+        count = len(sides) + 1
+        quaternions = np.zeros((count, 3, 4))
+        tangent, relative = np.zeros((count, 1, 3, 3)), np.zeros((count, 1, 3, 3))
+        frames = np.zeros((count, 4, 4, 4))   # B_0, B_1 of the plant, B_1 of the model in each mode
+        frames[:, 0] = np.eye(4)
+        for j in range(count):
             quaternions[j] = [*(c.joint_quaternions()[0] for c in chains.values()), quaternion_of(plant.relative[0])]
-            if j < len(sides):
+            tangent[j], relative[j] = plant.tangent, plant.relative
+            frames[j, 1:] = [poses(*(a[1] for a in body.frames())) for body in (plant, *chains.values())]
+            if j < count - 1:
                 for c in chains.values():
                     c.roll(sides[j:j + 1], dt)
                 plant.roll(sides[j:j + 1], dt)
@@ -409,6 +417,12 @@ def reach_floor(cfg: DictConfig) -> list[Case]:
                        name=[f"{m}.{c}" for m in (*reach.MODES, "plant") for c in ("qw", "qx", "qy", "qz")],
                        value=quaternions.reshape(len(t), -1))
         log.log_series("/reference", t[:-1], units="rad", name=["x", "y"], velocity=sides)   # Ω^B, rad/s
+        # the plant drawn as a robot (revolute.py), B_1 of the model in each mode beside it
+        ghosts = [f"B1_{mode}" for mode in chains]
+        log.log_transforms(t, "world", ["B0", "B1", *ghosts], frames)
+        log.attach("model.xml", revolute.chain_xml(radii[:2], "src-joint"), "application/xml")
+        log.log_robot(t, revolute.hinge_angles(tangent, relative, radii[:2]))
+        log_spheres(log, ghosts, [radius] * len(ghosts), [GHOST_COLOR, LITERAL_COLOR])
 
     cases = [Case(name, lambda log, x=name: simulate_target(log, x)) for name in sc.targets]
     return [*cases, Case("eq5-loop", simulate_loop)]
