@@ -119,13 +119,25 @@ class Rows:
         # bytes the same in every row (runs of them merged), or (N, w) bytes per row with the count used of
         # each row (None where every row uses all w)
         self._parts: list[bytes | tuple[np.ndarray, np.ndarray | None]] = []
+        self._width = 0  # bytes of every row, besides the used bytes of the variable parts
+        self._variable: list[np.ndarray] = []
+
+    def _add(self, part: bytes | tuple[np.ndarray, np.ndarray | None]) -> Rows:
+        if isinstance(part, bytes):
+            if not part:
+                return self
+            self._width += len(part)
+            if self._parts and isinstance(self._parts[-1], bytes):
+                part = self._parts.pop() + part
+        elif part[1] is None:
+            self._width += part[0].shape[1]
+        else:
+            self._variable.append(part[1])
+        self._parts.append(part)
+        return self
 
     def constant(self, data: bytes) -> Rows:
-        if data:
-            if self._parts and isinstance(self._parts[-1], bytes):
-                data = self._parts.pop() + data
-            self._parts.append(data)
-        return self
+        return self._add(data)
 
     def string(self, number: int, text: str) -> Rows:
         raw = text.encode()
@@ -137,15 +149,13 @@ class Rows:
         block = np.empty((self.n, len(numbers), 9), dtype=np.uint8)
         block[:, :, 0] = [number << 3 | 1 for number in numbers]
         block[:, :, 1:] = np.ascontiguousarray(values).view(np.uint8).reshape(self.n, len(numbers), 8)
-        self._parts.append((block.reshape(self.n, -1), None))
-        return self
+        return self._add((block.reshape(self.n, -1), None))
 
     def _integers(self, values: np.ndarray) -> Rows:
         values = np.asarray(values)
         if len(values) and (values == values[0]).all():  # the same in every row: a constant
             return self.constant(_varint(int(values[0])))
-        self._parts.append(_varints(values))
-        return self
+        return self._add(_varints(values))
 
     def varint(self, number: int, values: np.ndarray) -> Rows:
         return self.constant(_varint(number << 3))._integers(values)
@@ -153,18 +163,13 @@ class Rows:
     def message(self, number: int, inner: Rows) -> Rows:
         self.constant(_varint(number << 3 | 2))._integers(inner.lengths())
         for part in inner._parts:
-            if isinstance(part, bytes):
-                self.constant(part)
-            else:
-                self._parts.append(part)
+            self._add(part)
         return self
 
     def lengths(self) -> np.ndarray:
-        total = np.full(self.n, sum(_width(part) for part in self._parts if _used(part) is None), dtype=np.int64)
-        for part in self._parts:
-            used = _used(part)
-            if used is not None:
-                total += used
+        total = np.full(self.n, self._width, dtype=np.int64)
+        for used in self._variable:
+            total += used
         return total
 
     def serialize(self) -> list[bytes]:

@@ -154,6 +154,10 @@ def column_units(cls: type[Message], sample: Mapping[str, Any], units: EntryUnit
     return result
 
 
+# (topic, schema, names, kind, units given, shape of each field) -> column -> unit, for every writer of a process
+_DECLARED: dict[tuple, dict[str, str]] = {}
+
+
 class RunWriter:
     """Writes one run. Use as a context manager; `close(status)` publishes the file.
 
@@ -253,12 +257,15 @@ class RunWriter:
         key = (topic, cls, tuple(names or ()), sample.get("kind", ""),
                units if units is None or isinstance(units, str) else tuple(units),
                tuple((k, v if isinstance(v, str) else tuple(v)) for k, v in (field_units or {}).items()),
-               tuple((k, len(v) if isinstance(v, list | tuple | np.ndarray) else -1) for k, v in sample.items()))
+               tuple((k, np.shape(v) if isinstance(v, list | tuple | np.ndarray) else -1) for k, v in sample.items()))
         if key in self._declared:
             return
         self._declared.add(key)
         known = self._units.setdefault(topic, {})
-        for column, unit in column_units(cls, sample, units, field_units, topic).items():
+        declared = _DECLARED.get(key)
+        if declared is None:  # the same shape in every run of an experiment: its units worked out once
+            declared = _DECLARED[key] = column_units(cls, sample, units, field_units, topic)
+        for column, unit in declared.items():
             if known.setdefault(column, unit) != unit:
                 raise ValueError(f"{topic}: column {column} was logged in {known[column]}, now in {unit}")
 

@@ -90,7 +90,15 @@ class Pose:
         return self @ Pose(np.asarray(p, dtype=float), np.array([1.0, 0.0, 0.0, 0.0]))
 
     def rpy(self) -> np.ndarray:
-        return _euler(self.q[None], "xyz")[0]  # URDF: fixed-axis roll, pitch, yaw
+        return np.array(_rpy(np.asarray(self.q, dtype=float).tobytes()))
+
+
+@functools.lru_cache(maxsize=4096)
+def _rpy(wxyz: bytes) -> tuple[float, float, float]:
+    """URDF's fixed-axis roll, pitch, yaw of a quaternion (its float64 bytes: -0.0 is not 0.0 to atan2),
+    remembered: a model's geoms and joints repeat a few orientations (a capsule's cylinder and end spheres, the
+    same arm with other servo gains), and SciPy costs tens of µs a call."""
+    return tuple(_euler(np.frombuffer(wxyz, dtype=float)[None], "xyz")[0].tolist())
 
 
 @dataclass(frozen=True)
