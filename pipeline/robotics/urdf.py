@@ -45,25 +45,17 @@ _FALLBACK_RGBA = (0.55, 0.6, 0.7, 1.0)
 
 def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Hamilton product of (..., 4) wxyz quaternions, batched."""
-    aw, ax, ay, az = a[..., 0], a[..., 1], a[..., 2], a[..., 3]  # (indexing: np.moveaxis costs more for one pose)
-    bw, bx, by, bz = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
+    aw, ax, ay, az = np.moveaxis(a, -1, 0)
+    bw, bx, by, bz = np.moveaxis(b, -1, 0)
     return np.stack([aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
                      aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw], axis=-1)
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """np.cross of (..., 3) vectors, the same products and differences without its per-call overhead (a
-    URDF is described from hundreds of single poses)."""
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
 def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Rotate (..., 3) vectors by (..., 4) wxyz quaternions."""
     w, u = q[..., :1], q[..., 1:]
-    t = 2.0 * _cross(u, v)
-    return v + w * t + _cross(u, t)
+    t = 2.0 * np.cross(u, v)
+    return v + w * t + np.cross(u, t)
 
 
 def _axis_angle(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
@@ -308,8 +300,7 @@ def _stick_visuals(model, b: int) -> list[str]:
 @functools.lru_cache(maxsize=8)
 def described(xml: str) -> tuple[Any, RobotDescription]:
     """The compiled `MjModel` of an MJCF text (shared with mjcf.servo_rollout, read-only) and its robot
-    description, made once per process for each model: describing costs about as much as 700 physics steps of
-    a 6-joint arm, and the runs a process logs mostly draw the same robot."""
+    description, made once per process for each model (the runs a process logs mostly draw the same robot)."""
     from pipeline.robotics.mjcf import compiled
 
     model = compiled(xml)
