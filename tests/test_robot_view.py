@@ -17,7 +17,7 @@ from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
 
 from pipeline.core import layouts, robot
 from pipeline.core.runlog import RunWriter, read_run
-from pipeline.robotics.urdf import Pose, describe
+from pipeline.robotics.urdf import Pose, _quat_mul, _rotate, describe
 
 from .conftest import ENV
 
@@ -310,3 +310,11 @@ def test_view_places_every_marker_in_its_frame(tmp_path):
     assert all("CoordinateFrame:frame" in line for line in geometry)
     cleared = {line.split(" - ")[1] for line in printed.splitlines() if "Clear:is_recursive" in line}
     assert cleared == {"/markers/contacts/arrows", "/markers/contacts/spheres"}   # the second instant has none
+
+
+def test_one_pose_composed_on_floats_equals_the_batched_arithmetic():
+    rng = np.random.default_rng(8)
+    for _ in range(500):
+        a, b = (Pose(rng.standard_normal(3), rng.standard_normal(4)) for _ in range(2))
+        c = a @ b
+        assert np.array_equal(c.p, a.p + _rotate(a.q, b.p)) and np.array_equal(c.q, _quat_mul(a.q, b.q))

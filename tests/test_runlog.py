@@ -189,3 +189,49 @@ def test_typed_values_and_a_sweep_in_one_frame(tmp_path):
     assert frame.attrs["units"]["norm"] == "rad"
     table = read_runs(tmp_path).table()
     assert table["execute.gain"].tolist() == [2.0, 8.0]
+
+
+def test_series_encoded_in_numpy_equal_protobufs_byte_for_byte():
+    """Rows of several varint layouts (timestamps and names of different lengths, interleaved) come out in
+    row order and byte for byte as protobuf serializes them; so do fixed-layout series."""
+    from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
+
+    from pipeline.core import robot
+    from pipeline.core.encoding import encode_series
+
+    rng = np.random.default_rng(4)
+    times_ns = np.array([1_000_000_001, 300 * 10**9 + 999, 2_000_000_000 + 10**8, 5 * 10**9 + 7, 1_500_000_000])
+    children = ["a", "b" * 200]
+    trans, quats = rng.uniform(0.1, 1, (5, 2, 3)), rng.uniform(0.1, 1, (5, 2, 4))  # no zeros: proto3 omits them
+    expected = [FrameTransforms(transforms=[
+        {"timestamp": {"seconds": int(t // 10**9), "nanos": int(t % 10**9)}, "parent_frame_id": "world",
+         "child_frame_id": c, "translation": dict(zip("xyz", trans[i, k], strict=True)),
+         "rotation": dict(zip("wxyz", quats[i, k], strict=True))} for k, c in enumerate(children)]).SerializeToString()
+        for i, t in enumerate(times_ns)]
+    assert robot.frame_transforms(times_ns, ["world"] * 2, children, trans, quats) == expected
+    position = rng.uniform(0.1, 1, (5, 3))
+    assert encode_series(schemas.JointState, {"name": NAMES}, {"position": position}) == \
+        [schemas.JointState(name=NAMES, position=p).SerializeToString() for p in position]
+
+
+def test_quaternions_equal_scipys_bit_for_bit():
+    from scipy.spatial.transform import Rotation
+
+    from pipeline.robotics import dh
+    from pipeline.robotics.transforms import quaternion_wxyz
+
+    def scipy(R):
+        return Rotation.from_matrix(R.reshape(-1, 3, 3)).as_quat(scalar_first=True).reshape(*R.shape[:-2], 4)
+
+    rng = np.random.default_rng(5)
+    axes = np.eye(3)[rng.integers(0, 3, 300)]  # half turns and quarter turns about the axes: every branch, ties
+    special = Rotation.from_rotvec(axes * rng.choice([0.0, np.pi / 2, np.pi, -np.pi / 2], 300)[:, None]).as_matrix()
+    ur5 = dh.DH(np.array([np.pi / 2, 0, 0, np.pi / 2, -np.pi / 2, 0]), np.array([0, -0.425, -0.392, 0, 0, 0]),
+                np.array([0.089, 0, 0, 0.109, 0.095, 0.082]), np.zeros(6))
+    for R in (Rotation.random(20_000, random_state=6).as_matrix(), special,
+              dh.frames(ur5, rng.uniform(-np.pi, np.pi, (500, 6)))[:, :, :3, :3]):
+        assert np.array_equal(quaternion_wxyz(R).view(np.int64), scipy(R).view(np.int64))
+    skewed = Rotation.random(3, random_state=7).as_matrix() * (1 + 1e-9)  # SciPy projects it onto a rotation
+    assert np.array_equal(quaternion_wxyz(skewed), scipy(skewed))
+    with pytest.raises(ValueError, match="determinant"):
+        quaternion_wxyz(np.diag([1.0, 1.0, -1.0]))

@@ -9,6 +9,8 @@ what `SerializeToString` makes (tests hold the two equal), at a fraction of the 
 
 from __future__ import annotations
 
+import struct
+from operator import itemgetter
 from typing import Any
 
 import numpy as np
@@ -76,18 +78,20 @@ def encode_series(cls: type[Message], constant: dict[str, Any],
     records = np.empty(n, dtype=dtype)
     for key, value in fill.items():
         records[key] = np.void(value) if isinstance(value, bytes) else value
-    buffer = records.tobytes()
-    size = records.dtype.itemsize
-    return [buffer[i * size:(i + 1) * size] for i in range(n)]
+    return _split(records.view(np.uint8).reshape(n, records.dtype.itemsize))
 
 
 # ---------------------------------------------------------------------------------------------------
 # Messages of variable length (timestamps, nested messages), built column by column
 
 
-def _varints(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Base-128 varints of non-negative integers: (N, 10) bytes and the (N,) count used of each row."""
-    v = np.asarray(values, dtype=np.uint64).copy()
+def _varints(values: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """Base-128 varints of non-negative integers: (N, w) bytes and the (N,) count used of each row, or None when
+    every row uses all w (the common case of lengths and small counts: a fixed-width part)."""
+    v = np.asarray(values, dtype=np.uint64)
+    if not len(v) or int(v.max()) < 0x80:
+        return v.astype(np.uint8)[:, None], None
+    v = v.copy()
     out = np.zeros((len(v), 10), dtype=np.uint8)
     used = np.ones(len(v), dtype=np.int64)
     for i in range(10):
@@ -95,10 +99,11 @@ def _varints(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         v >>= np.uint64(7)
         more = v > 0
         if not more.any():
-            return out[:, :i + 1], used
+            break
         out[more, i] |= 0x80
         used += more
-    return out, used
+    out = out[:, :int(used.max())]
+    return (out, None) if used.min() == out.shape[1] else (out, used)
 
 
 class Rows:
@@ -111,12 +116,28 @@ class Rows:
 
     def __init__(self, n: int):
         self.n = n
-        self._parts: list[tuple[np.ndarray, np.ndarray | None]] = []  # (N, w) bytes, bytes used per row
+        # bytes the same in every row (runs of them merged), or (N, w) bytes per row with the count used of
+        # each row (None where every row uses all w)
+        self._parts: list[bytes | tuple[np.ndarray, np.ndarray | None]] = []
+        self._width = 0  # bytes of every row, besides the used bytes of the variable parts
+        self._variable: list[np.ndarray] = []
+
+    def _add(self, part: bytes | tuple[np.ndarray, np.ndarray | None]) -> Rows:
+        if isinstance(part, bytes):
+            if not part:
+                return self
+            self._width += len(part)
+            if self._parts and isinstance(self._parts[-1], bytes):
+                part = self._parts.pop() + part
+        elif part[1] is None:
+            self._width += part[0].shape[1]
+        else:
+            self._variable.append(part[1])
+        self._parts.append(part)
+        return self
 
     def constant(self, data: bytes) -> Rows:
-        if data:
-            self._parts.append((np.broadcast_to(np.frombuffer(data, dtype=np.uint8), (self.n, len(data))), None))
-        return self
+        return self._add(data)
 
     def string(self, number: int, text: str) -> Rows:
         raw = text.encode()
@@ -128,34 +149,75 @@ class Rows:
         block = np.empty((self.n, len(numbers), 9), dtype=np.uint8)
         block[:, :, 0] = [number << 3 | 1 for number in numbers]
         block[:, :, 1:] = np.ascontiguousarray(values).view(np.uint8).reshape(self.n, len(numbers), 8)
-        self._parts.append((block.reshape(self.n, -1), None))
-        return self
+        return self._add((block.reshape(self.n, -1), None))
+
+    def _integers(self, values: np.ndarray) -> Rows:
+        values = np.asarray(values)
+        if len(values) and (values == values[0]).all():  # the same in every row: a constant
+            return self.constant(_varint(int(values[0])))
+        return self._add(_varints(values))
 
     def varint(self, number: int, values: np.ndarray) -> Rows:
-        data, used = _varints(values)
-        self.constant(_varint(number << 3))
-        self._parts.append((data, used))
-        return self
+        return self.constant(_varint(number << 3))._integers(values)
 
     def message(self, number: int, inner: Rows) -> Rows:
-        data, used = _varints(inner.lengths())
-        self.constant(_varint(number << 3 | 2))
-        self._parts.append((data, used))
-        self._parts.extend(inner._parts)
+        self.constant(_varint(number << 3 | 2))._integers(inner.lengths())
+        for part in inner._parts:
+            self._add(part)
         return self
 
     def lengths(self) -> np.ndarray:
-        total = np.zeros(self.n, dtype=np.int64)
-        for data, used in self._parts:
-            total += data.shape[1] if used is None else used
+        total = np.full(self.n, self._width, dtype=np.int64)
+        for used in self._variable:
+            total += used
         return total
 
     def serialize(self) -> list[bytes]:
+        """One `bytes` per row. Rows whose varints have the same lengths share one layout: each such group is
+        cut from one table in C, with no per-row work in Python."""
         if not self._parts:
             return [b""] * self.n
-        table = np.concatenate([data for data, _ in self._parts], axis=1)
-        keep = np.concatenate([np.ones(data.shape, dtype=bool) if used is None
-                               else np.arange(data.shape[1]) < used[:, None] for data, used in self._parts], axis=1)
-        buffer = table[keep].tobytes()  # row-major: row i's kept bytes are contiguous
-        ends = np.cumsum(keep.sum(axis=1)).tolist()
-        return [buffer[a:b] for a, b in zip([0, *ends[:-1]], ends, strict=True)]
+        table = np.concatenate([np.broadcast_to(np.frombuffer(part, dtype=np.uint8), (self.n, len(part)))
+                                if isinstance(part, bytes) else part[0] for part in self._parts], axis=1)
+        variable = [(k, used) for k, used in enumerate(map(_used, self._parts)) if used is not None]
+        if not variable:
+            return _split(table)
+        starts = np.cumsum([0] + [_width(part) for part in self._parts])
+        # rows whose varints have the same lengths (a varint has 1 to 10 bytes): one key per layout
+        key = np.zeros(self.n, dtype=object if len(variable) > 18 else np.int64)
+        for _, used in variable:
+            key = key * 11 + used
+        keys, group = np.unique(key, return_inverse=True)
+        if len(keys) == 1:
+            group_rows = [np.arange(self.n)]
+        else:
+            group_rows = [np.flatnonzero(group == g) for g in range(len(keys))]
+        pieces: list[bytes] = []
+        for rows in group_rows:
+            signature = [int(used[rows[0]]) for _, used in variable]
+            block = table[rows]
+            keep, start = [], 0  # column ranges of this layout: each variable part cut to its used bytes
+            for (k, _), u in zip(variable, signature, strict=True):
+                keep.append(block[:, start:starts[k] + u])
+                start = starts[k + 1]
+            keep.append(block[:, start:])
+            pieces += _split(np.concatenate(keep, axis=1))
+        if len(group_rows) == 1:
+            return pieces
+        order = np.argsort(np.concatenate(group_rows)).tolist()  # back to row order
+        return [pieces[order[0]]] if self.n == 1 else list(itemgetter(*order)(pieces))
+
+
+def _width(part: bytes | tuple[np.ndarray, np.ndarray | None]) -> int:
+    return len(part) if isinstance(part, bytes) else part[0].shape[1]
+
+
+def _used(part: bytes | tuple[np.ndarray, np.ndarray | None]) -> np.ndarray | None:
+    return None if isinstance(part, bytes) else part[1]
+
+
+def _split(table: np.ndarray) -> list[bytes]:
+    """The rows of a (N, w) uint8 table as `bytes`, cut in C (a third of the cost of slicing in a Python loop)."""
+    if not table.shape[1]:
+        return [b""] * len(table)
+    return list(map(itemgetter(0), struct.iter_unpack(f"{table.shape[1]}s", np.ascontiguousarray(table).tobytes())))

@@ -10,6 +10,7 @@ Foxglove → Layouts → Import from file, then open the run.
 
 from __future__ import annotations
 
+import functools
 import importlib
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -83,9 +84,13 @@ def _plot(plot: Plot) -> fl.PlotPanel:
 def foxglove_layout(topics: Iterable[str], slug: str | None = None) -> str:
     """The Foxglove layout (JSON) of a run with these topics: the 3-D scene (URDF driven by the joint
     states, /tf frames, /markers) beside the key plots."""
+    return _foxglove_layout(frozenset(topics), slug)
+
+
+@functools.lru_cache(maxsize=64)  # the runs of an experiment share their topics: one layout, made once
+def _foxglove_layout(topics: frozenset[str], slug: str | None) -> str:
     import foxglove.layouts as fl
 
-    topics = set(topics)
     plots = [fl.SplitItem(content=_plot(p)) for p in key_plots(topics, slug)]
     scene = fl.SplitItem(proportion=2 if plots else 1, content=_three_d(topics))
     right = [fl.SplitItem(content=fl.SplitContainer(direction="column", items=plots))] if plots else []

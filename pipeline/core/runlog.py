@@ -8,8 +8,11 @@ file atomically.
 
 from __future__ import annotations
 
+import functools
 import json
+from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
+from itertools import chain
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -75,6 +78,7 @@ def seconds_to_ns(t: float | np.ndarray) -> int | np.ndarray:
     return round(t * 1e9)
 
 
+@functools.cache
 def _file_descriptor_set(descriptor: Descriptor) -> bytes:
     """The schema bytes MCAP wants for protobuf: the message's file and all it imports."""
     fds = descriptor_pb2.FileDescriptorSet()
@@ -148,6 +152,10 @@ def column_units(cls: type[Message], sample: Mapping[str, Any], units: EntryUnit
                 raise ValueError(f"{topic}: the unit of {label} is not known: pass {hint}")
             result[label] = unit
     return result
+
+
+# (topic, schema, names, kind, units given, shape of each field) -> column -> unit, for every writer of a process
+_DECLARED: dict[tuple, dict[str, str]] = {}
 
 
 class RunWriter:
@@ -249,12 +257,15 @@ class RunWriter:
         key = (topic, cls, tuple(names or ()), sample.get("kind", ""),
                units if units is None or isinstance(units, str) else tuple(units),
                tuple((k, v if isinstance(v, str) else tuple(v)) for k, v in (field_units or {}).items()),
-               tuple((k, len(v) if isinstance(v, list | tuple | np.ndarray) else -1) for k, v in sample.items()))
+               tuple((k, np.shape(v) if isinstance(v, list | tuple | np.ndarray) else -1) for k, v in sample.items()))
         if key in self._declared:
             return
         self._declared.add(key)
         known = self._units.setdefault(topic, {})
-        for column, unit in column_units(cls, sample, units, field_units, topic).items():
+        declared = _DECLARED.get(key)
+        if declared is None:  # the same shape in every run of an experiment: its units worked out once
+            declared = _DECLARED[key] = column_units(cls, sample, units, field_units, topic)
+        for column, unit in declared.items():
             if known.setdefault(column, unit) != unit:
                 raise ValueError(f"{topic}: column {column} was logged in {known[column]}, now in {unit}")
 
@@ -285,22 +296,18 @@ class RunWriter:
         `mocap_quat` (N or 1, nmocap, 4, wxyz; default: as in the model). `model` (`MjModel` or MJCF) defaults
         to the attached `model.xml`. Call it again to append a later part of the same run; samples are
         thinned to robot.VIEW_RATE_HZ."""
-        import mujoco
-
-        from pipeline.robotics.urdf import describe
+        from pipeline.robotics.urdf import describe, described
 
         model = model if model is not None else self._model_xml
         if model is None:
             raise ValueError("log_robot: no model given and no model.xml attached")
-        if isinstance(model, str):
-            model = mujoco.MjModel.from_xml_string(model)
+        model, description = described(model) if isinstance(model, str) else (model, describe(model))
         times = np.atleast_1d(np.asarray(times, dtype=float))
         keep = robot.thinned(times)
         mocap_body = model.body_mocapid >= 0
         defaults = (model.body_pos[mocap_body], model.body_quat[mocap_body])
         mocap = [np.broadcast_to(default if a is None else a, (len(times), model.nmocap, default.shape[1]))[keep]
                  for a, default in zip((mocap_pos, mocap_quat), defaults, strict=True)]
-        description = describe(model)
         if self.robot is None:
             self.robot = description
             urdf = description.urdf()
@@ -343,9 +350,11 @@ class RunWriter:
         mocap bodies need the full state: call `log_robot`."""
         import mujoco
 
+        from pipeline.robotics.urdf import described
+
         if self.robot is not None or self._model_xml is None or self._joint_state is None:
             return
-        model = mujoco.MjModel.from_xml_string(self._model_xml)
+        model, _ = described(self._model_xml)
         if model.nmocap or any(int(t) in (mujoco.mjtJoint.mjJNT_FREE, mujoco.mjtJoint.mjJNT_BALL)
                                for t in model.jnt_type):
             return
@@ -357,7 +366,7 @@ class RunWriter:
         qpos = np.tile(model.qpos0, (len(times), 1))
         for j, name in enumerate(joints):
             qpos[:, model.jnt_qposadr[j]] = position[:, columns[name]]
-        self.log_robot(times, qpos, model=model)
+        self.log_robot(times, qpos, model=self._model_xml)
 
     def attach(self, name: str, data: bytes | str, media_type: str) -> None:
         if name == MODEL_ATTACHMENT:
@@ -387,13 +396,15 @@ class RunWriter:
             channel = foxglove.Channel(topic, schema=schema, message_encoding=message_encoding, context=self._context,
                                        metadata={UNITS_KEY: json.dumps(units)} if units else None)
             times = np.concatenate([t for t, _ in parts])
-            data = [b for _, chunk in parts for b in chunk]
+            data = parts[0][1] if len(parts) == 1 else list(chain.from_iterable(chunk for _, chunk in parts))
+            if len(times) != len(data):
+                raise ValueError(f"{topic}: {len(data)} messages for {len(times)} times")
             if len(times) > 1 and (np.diff(times) < 0).any():
                 order = np.argsort(times, kind="stable")  # equal times keep their logging order
                 times, data = times[order], [data[i] for i in order.tolist()]
-            log = channel.base.log  # the Rust channel itself: the Python wrapper only re-checks types
-            for t_ns, payload in zip(times.tolist(), data, strict=True):
-                log(payload, log_time=t_ns)
+            # The Rust channel itself (the Python wrapper only re-checks types), called from C by map: no
+            # Python work per message.
+            deque(map(channel.base.log, data, times.tolist()), maxlen=0)
             self._writer.flush()  # end the chunk: the next topic starts its own
         self._pending.clear()
 

@@ -8,6 +8,7 @@ geometric Jacobian of the DH model.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -141,6 +142,15 @@ SERVO_RULES = (
 )
 
 
+@functools.lru_cache(maxsize=8)
+def compiled(xml: str):
+    """The `MjModel` of an MJCF text, compiled once per process (a run's servo and its robot drawing share it).
+    Read-only: whoever needs to change a model compiles their own."""
+    import mujoco
+
+    return mujoco.MjModel.from_xml_string(xml)
+
+
 def servo_rollout(xml: str, q_ref: np.ndarray, qd_ref: np.ndarray, times: np.ndarray, *, moving_start: bool = False
                   ) -> tuple[np.ndarray, np.ndarray]:
     """A whole servoed run in one C call: the model's actuators are the joint servo (controls [q_ref, q̇_ref],
@@ -150,7 +160,7 @@ def servo_rollout(xml: str, q_ref: np.ndarray, qd_ref: np.ndarray, times: np.nda
     import mujoco
     from mujoco import rollout
 
-    model = mujoco.MjModel.from_xml_string(xml)
+    model = compiled(xml)
     data = mujoco.MjData(model)
     data.qpos[:] = q_ref[0]
     if moving_start:

@@ -8,10 +8,11 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 from pipeline.core.checks import compose_config
-from pipeline.core.runlog import MODEL_ATTACHMENT, RunWriter
+from pipeline.core.runlog import MODEL_ATTACHMENT, RunWriter, read_run
 from pipeline.core.timing import best_of, time_calls
 from pipeline.papers.curve_discretization import algorithm as dc
 from pipeline.papers.curve_discretization import experiments as ex
@@ -93,6 +94,10 @@ def snake_speed(rows: list[dict]) -> None:
 
         t_bare, t_run, t_log = best_of(bare), best_of(controlled), best_of(logging_only)
         t_with_replay = best_of(lambda: controlled(compare_warm_cold=True))
+        cpu = {fn: best_of(fn, clock=time.process_time) for fn in (bare, controlled, logging_only)}
+        written = read_run(Path(tmp) / "b.mcap")
+        messages = sum(written.message_count(t) for t in written.topic_names)
+        samples = written.message_count("/joint_state")
     system = f"MuJoCo snake, {sc.joints} joints, lateral undulation ({sc.duration:g} s, 1 kHz, algorithm at 100 Hz)"
     rows += [
         {"what": system, "measure": "bare mj_step", "value": t_bare / steps * 1e6, "unit": "µs/step"},
@@ -101,8 +106,13 @@ def snake_speed(rows: list[dict]) -> None:
         {"what": system, "measure": "the same, then Sec. IV-D's warm/cold search timing (an experiment, not control)",
          "value": t_with_replay / steps * 1e6, "unit": "µs/step"},
         {"what": system, "measure": "logging", "value": t_log / steps * 1e6, "unit": "µs/step"},
+        {"what": system, "measure": "messages per run (every topic, the robot drawing included)",
+         "value": messages, "unit": ""},
+        {"what": system, "measure": "messages per logged sample", "value": messages / samples, "unit": ""},
         {"what": system, "measure": "run + logging over bare mj_step", "value": (t_run + t_log) / t_bare, "unit": "×",
          "goal": "≤ 2"},
+        {"what": system, "measure": "the same in CPU time (this process)",
+         "value": (cpu[controlled] + cpu[logging_only]) / cpu[bare], "unit": "×", "goal": "≤ 2"},
         {"what": system, "measure": "simulated seconds per wall second", "value": sc.duration / (t_run + t_log),
          "unit": "s/s"},
     ]

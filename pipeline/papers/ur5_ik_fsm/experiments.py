@@ -187,7 +187,8 @@ def log_execution(log: RunWriter, cfg: DictConfig, g: Geometry, times, q_ref, qd
     # flange error of the executed motion against the desired path
     T_des = np.stack([np.interp(t_state, ik_times, poses[:, i, j]) for i in range(4) for j in range(4)],
                      axis=1).reshape(-1, 4, 4)
-    T_act = dhk.fk(dh, q)
+    link_frames = dhk.frames(dh, q)
+    T_act = link_frames[:, -1]
     dp = T_des[:, :3, 3] - T_act[:, :3, 3]
     rot = rotation_angle(T_des[:, :3, :3], T_act[:, :3, :3])
     log.log_series("/tracking_error/flange", t_state, units=["m", "m", "m", "rad"], field_units={"norm": "m"},
@@ -195,7 +196,8 @@ def log_execution(log: RunWriter, cfg: DictConfig, g: Geometry, times, q_ref, qd
                    error=np.column_stack([dp, rot]), norm=np.linalg.norm(dp, axis=1))
     tf = slice(None, None, max(1, round(cfg.execute.tf_dt / dt)))
     t_tf = (times + dt)[tf]
-    frames = dhk.frames(dh, states[tf, 1:7])[:, 1:]
+    logged = tf.step % every.step == 0  # the frames' samples are logged samples: their frames are computed
+    frames = (link_frames[::tf.step // every.step] if logged else dhk.frames(dh, states[tf, 1:7]))[:, 1:]
     target = poses[np.searchsorted(ik_times, t_tf).clip(max=len(poses) - 1)]
     log.log_transforms(t_tf, "base", [*(f"link{i}" for i in range(1, 7)), "target"],
                        np.concatenate([frames, target[:, None]], axis=1))
