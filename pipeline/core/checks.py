@@ -21,9 +21,6 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from hydra import compose, initialize_config_dir
-from hydra.core.global_hydra import GlobalHydra
-from hydra.core.override_parser.overrides_parser import OverridesParser
 from omegaconf import DictConfig, ListConfig, OmegaConf, open_dict
 
 from pipeline.core.experiment import (
@@ -320,6 +317,8 @@ def _variants(overrides: list[str]) -> tuple[list[tuple[str | None, list[str]]],
     """(experiment, overrides) to compose and check, and whether anything is swept. Every check is on one value
     at a time, so a sweep needs each swept value once (beside the fixed overrides), not every combination:
     1 + Σk, not Πk."""
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+
     parsed = OverridesParser.create().parse_overrides(overrides)
     fixed, swept = [], {}
     for o in parsed:
@@ -369,6 +368,9 @@ def _listing(known: list[str]) -> str:
 def compose_config(overrides: list[str], with_hydra: bool = False) -> DictConfig:
     """The config Hydra would build for these overrides (no sweep syntax); `with_hydra`: with its `hydra` node,
     as Hydra hands it to a job (pipeline/__main__.py runs a single run on it without composing it again)."""
+    from hydra import compose, initialize_config_dir
+    from hydra.core.global_hydra import GlobalHydra
+
     GlobalHydra.instance().clear()
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base=None):
         return compose(config_name="config", overrides=overrides, return_hydra_config=with_hydra)
@@ -430,5 +432,7 @@ def preflight(argv: list[str]) -> DictConfig | None:
         check_rules(cfg, experiment)
         check_cases(cfg, experiment)
         check_episodes(cfg, experiment)
+    from hydra.core.global_hydra import GlobalHydra
+
     GlobalHydra.instance().clear()
     return None if sweep else composed
