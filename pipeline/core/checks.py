@@ -384,6 +384,28 @@ def _without_hydra(cfg: DictConfig) -> DictConfig:
     return job
 
 
+def compose_with_defaults(overrides: list[str]) -> tuple[DictConfig, DictConfig | None]:
+    """The config Hydra composes for `overrides` (with its `hydra` node), and the experiment's defaults: the
+    same composition just before Hydra applies the overrides' values, when every override but `experiment=` is
+    a value (none chooses a config group; else None). One composition where the checks would need two."""
+    from hydra._internal.config_loader_impl import ConfigLoaderImpl
+
+    apply = ConfigLoaderImpl._apply_overrides_to_config
+    before: list[tuple[int, DictConfig]] = []
+
+    def recording(values: list, cfg: DictConfig) -> None:
+        before.append((len(values), _without_hydra(cfg)))
+        apply(values, cfg)
+
+    ConfigLoaderImpl._apply_overrides_to_config = staticmethod(recording)
+    try:
+        composed = compose_config(overrides, with_hydra=True)
+    finally:
+        ConfigLoaderImpl._apply_overrides_to_config = staticmethod(apply)
+    values_only = len(before) == 1 and before[0][0] == len(overrides) - 1
+    return composed, before[0][1] if values_only else None
+
+
 def preflight(argv: list[str]) -> DictConfig | None:
     """Refuse bad input before Hydra launches anything. Returns the checked config, with its `hydra` node, when
     `argv` makes one job (no sweep), so that it need not be composed again."""
@@ -418,14 +440,14 @@ def preflight(argv: list[str]) -> DictConfig | None:
         if not sweep:   # in the order given: Hydra records them (hydra.overrides.task)
             job_overrides = [o for o in overrides if not o.lstrip("+~").startswith("hydra")]
         try:
-            composed = compose_config(job_overrides, with_hydra=True)
+            composed, defaults = compose_with_defaults(job_overrides)
         except Exception as err:
             defaults = compose_config([f"experiment={experiment_id}"])
             raise BadInput(_one_line(err, job_overrides, [k for k, _ in _leaves(defaults)])) from None
         cfg = _without_hydra(composed)
-        if experiment_id not in checked:   # the experiment's own defaults: the same config when nothing is overridden
-            defaults = cfg if len(job_overrides) == 1 else compose_config([f"experiment={experiment_id}"])
-            checked[experiment_id] = (defaults, resolve(experiment_id))
+        if experiment_id not in checked:
+            checked[experiment_id] = (defaults or compose_config([f"experiment={experiment_id}"]),
+                                      resolve(experiment_id))
         defaults, experiment = checked[experiment_id]
         check_data_dir(cfg.data_dir)
         check_config(cfg, defaults, experiment.limits)
