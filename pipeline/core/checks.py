@@ -454,7 +454,4 @@ def preflight(argv: list[str]) -> DictConfig | None:
         check_rules(cfg, experiment)
         check_cases(cfg, experiment)
         check_episodes(cfg, experiment)
-    from hydra.core.global_hydra import GlobalHydra
-
-    GlobalHydra.instance().clear()
-    return None if sweep else composed
+    return None if sweep else composed   # (each composition leaves Hydra uninitialised, as it found it)
