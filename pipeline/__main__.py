@@ -100,11 +100,10 @@ def _run_job(task: Callable[[DictConfig], None], cfg: DictConfig) -> None:
     from hydra._internal.callbacks import Callbacks
     from hydra._internal.utils import run_and_report
     from hydra.core.utils import configure_log, run_job
-    from hydra.types import HydraContext, RunMode
+    from hydra.types import HydraContext
 
     def run() -> None:
         configure_log(cfg.hydra.hydra_logging, cfg.hydra.verbose)
-        cfg.hydra.mode = RunMode.RUN
         callbacks = Callbacks(cfg)
         callbacks.on_run_start(config=cfg, config_name="config")
         ret = run_job(hydra_context=HydraContext(config_loader=None, callbacks=callbacks), task_function=task,

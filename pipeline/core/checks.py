@@ -371,8 +371,8 @@ def compose_config(overrides: list[str], with_hydra: bool = False) -> DictConfig
     from hydra import compose, initialize_config_dir
     from hydra.core.global_hydra import GlobalHydra
 
-    GlobalHydra.instance().clear()
-    with initialize_config_dir(config_dir=str(CONF_DIR), version_base=None):
+    GlobalHydra.instance().clear()   # job name: the one @hydra.main gives `python -m pipeline`
+    with initialize_config_dir(config_dir=str(CONF_DIR), job_name="__main__", version_base=None):
         return compose(config_name="config", overrides=overrides, return_hydra_config=with_hydra)
 
 
@@ -439,8 +439,8 @@ def preflight(argv: list[str]) -> DictConfig | None:
         job_overrides = [f"experiment={experiment_id}", *(o for o in extra if not o.lstrip("+~").startswith("hydra"))]
         if not sweep:   # in the order given: Hydra records them (hydra.overrides.task)
             job_overrides = [o for o in overrides if not o.lstrip("+~").startswith("hydra")]
-        try:
-            composed, defaults = compose_with_defaults(job_overrides)
+        try:   # one job: composed as @hydra.main composes a single run (it adds hydra.mode=RUN)
+            composed, defaults = compose_with_defaults(job_overrides + ([] if sweep else ["hydra.mode=RUN"]))
         except Exception as err:
             defaults = compose_config([f"experiment={experiment_id}"])
             raise BadInput(_one_line(err, job_overrides, [k for k, _ in _leaves(defaults)])) from None
