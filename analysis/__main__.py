@@ -12,12 +12,20 @@ Bad input is refused in one line before Hydra starts (exit 2, nothing written).
 from __future__ import annotations
 
 import difflib
+import logging
+import re
 import sys
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from omegaconf import DictConfig
 
 KEYS = {"experiment": None, "data_dir": "data", "stage": "all", "workers": "0"}
 STAGES = ("all", "analyze", "report")
 CONF_DIR = Path(__file__).resolve().parent / "conf"
+PLAIN = re.compile(r"[\w./~+@:-]*")   # a value Hydra's override grammar reads as this very string
 
 
 def parse(overrides: list[str]) -> dict[str, str | None]:
@@ -58,38 +66,37 @@ def parse(overrides: list[str]) -> dict[str, str | None]:
 
 
 def main() -> None:
-    from pipeline.core.cli import register_help_resolver, runs_nothing, split_args
+    from pipeline.core.cli import runs_nothing, split_args
 
     flags, overrides = split_args(sys.argv[1:])
     sys.argv[1:] = flags + overrides
+    args = None
     if not runs_nothing(flags):
         try:
-            parse(overrides)
+            args = parse(overrides)
         except ValueError as err:
             print(f"error: {err}", file=sys.stderr)
             sys.exit(2)
 
-    import hydra
-    from omegaconf import DictConfig
+    from pipeline.core import interrupts, stages
 
-    from pipeline.core import interrupts
-
-    register_help_resolver()
-
-    @hydra.main(config_path=str(CONF_DIR), config_name="analysis", version_base=None)
-    def task(cfg: DictConfig) -> None:
+    def task(cfg: DictConfig | dict) -> None:
         from analysis.core.stages import run
 
-        code = run(Path(cfg.data_dir), cfg.experiment, cfg.stage, int(cfg.workers))
+        code = run(Path(cfg["data_dir"]), cfg["experiment"], cfg["stage"], int(cfg["workers"]))
         if code:
             raise SystemExit(code)
-
-    from pipeline.core import stages
 
     interrupts.install()
     code: int | str | None = 0
     try:
-        task()
+        if args is not None and not flags and all(PLAIN.fullmatch(v or "") for v in args.values()):
+            # the checked keys, read by Hydra's grammar as these very strings: no config to compose; the
+            # logging Hydra would set up (hydra/job_logging=stdout, conf/analysis.yaml)
+            logging.basicConfig(level=logging.INFO, stream=sys.stdout, format="%(message)s", force=True)
+            task(args)
+        else:
+            _hydra_main(task)
     except KeyboardInterrupt as err:  # every output is published whole, so nothing half-written is left
         print("interrupted", file=sys.stderr)
         code = interrupts.exit_code(err)
@@ -99,6 +106,16 @@ def main() -> None:
         stages.record(stages.argument(overrides, "data_dir", "data"), stages.argument(overrides, "stage", "all"),
                       stages.argument(overrides, "experiment"))
     sys.exit(code)
+
+
+def _hydra_main(task: Callable[[DictConfig], None]) -> None:
+    """Hydra's own command line: --help, --cfg job, --info, and values in Hydra's override grammar."""
+    import hydra
+
+    from pipeline.core.cli import register_help_resolver
+
+    register_help_resolver()
+    hydra.main(config_path=str(CONF_DIR), config_name="analysis", version_base=None)(task)()
 
 
 if __name__ == "__main__":

@@ -16,7 +16,16 @@ import pytest
 from omegaconf import OmegaConf
 
 from pipeline.core import files
-from pipeline.core.checks import BadInput, _leaves, check_config, check_rules, compose_config, declared, preflight
+from pipeline.core.checks import (
+    BadInput,
+    _leaves,
+    check_config,
+    check_rules,
+    compose_config,
+    compose_with_defaults,
+    declared,
+    preflight,
+)
 from pipeline.core.experiment import OneOf, Text, available_experiments, resolve
 from pipeline.core.runlog import RunWriter, SimulationFailed, read_run, run_files
 
@@ -139,6 +148,17 @@ def test_every_size_step_and_choice_is_declared(experiment_id):
 def test_every_default_config_passes_its_own_checks():
     for experiment_id in available_experiments():
         preflight([f"experiment={experiment_id}"])
+
+
+def test_one_composition_gives_the_config_and_the_defaults_it_is_checked_against():
+    """preflight composes once: the config just before Hydra applies the overrides' values is what composing
+    the experiment alone gives; an override that chooses a config group gets no such defaults."""
+    for experiment_id in {e.split("/")[0]: e for e in available_experiments()}.values():  # one per paper
+        composed, defaults = compose_with_defaults(["progress=false", f"experiment={experiment_id}", "seed=3"])
+        assert OmegaConf.to_yaml(defaults) == OmegaConf.to_yaml(compose_config([f"experiment={experiment_id}"]))
+        assert composed.seed == 3 and composed.progress is False and "hydra" in composed
+    composed, defaults = compose_with_defaults(["experiment=ur5-ik-fsm/tables", "system=cobot-6r-ik"])
+    assert defaults is None and composed.hydra.runtime.choices.system == "cobot-6r-ik"
 
 
 # -- concurrent writers ------------------------------------------------------------------------------------

@@ -24,7 +24,6 @@ from types import ModuleType
 
 import pandas as pd
 
-from analysis.core import report
 from analysis.core.figures import Figures
 from analysis.core.metrics import read_metrics, write_metrics
 from analysis.core.targets import evaluate, load_targets, self_check
@@ -91,6 +90,8 @@ def _runs_table(metrics_dir: Path) -> pd.DataFrame:
 def write_report(data_dir: Path) -> tuple[Path, list[str]]:
     """Every page, the index and targets.csv; and the report's self-check: what its declarations get wrong (a
     band paper.yaml does not justify, a banded miss whose cause the band rules out: targets.self_check)."""
+    from analysis.core import report  # the page templates (jinja2, markdown): not needed to analyze
+
     report_dir = data_dir / "report"
     pages, all_evaluated, problems = [], [], []
     for slug in analyzed_slugs():

@@ -10,6 +10,7 @@ data_dir every output goes under.
 
 from __future__ import annotations
 
+import copy
 import difflib
 import importlib.util
 import math
@@ -20,10 +21,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from hydra import compose, initialize_config_dir
-from hydra.core.global_hydra import GlobalHydra
-from hydra.core.override_parser.overrides_parser import OverridesParser
-from omegaconf import DictConfig, ListConfig, OmegaConf
+from omegaconf import DictConfig, ListConfig, OmegaConf, open_dict
 
 from pipeline.core.experiment import (
     CONF_DIR,
@@ -315,9 +313,12 @@ def check_data_dir(value: Any) -> Path:
     return path
 
 
-def _variants(overrides: list[str]) -> list[tuple[str | None, list[str]]]:
-    """(experiment, overrides) to compose and check. Every check is on one value at a time, so a sweep
-    needs each swept value once (beside the fixed overrides), not every combination: 1 + Σk, not Πk."""
+def _variants(overrides: list[str]) -> tuple[list[tuple[str | None, list[str]]], bool]:
+    """(experiment, overrides) to compose and check, and whether anything is swept. Every check is on one value
+    at a time, so a sweep needs each swept value once (beside the fixed overrides), not every combination:
+    1 + Σk, not Πk."""
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+
     parsed = OverridesParser.create().parse_overrides(overrides)
     fixed, swept = [], {}
     for o in parsed:
@@ -331,6 +332,7 @@ def _variants(overrides: list[str]) -> list[tuple[str | None, list[str]]]:
         runs *= len(values)
     if runs > SWEEP_LIMIT:
         raise BadInput(f"the sweep has {runs} runs, more than {SWEEP_LIMIT}; split it")
+    sweep = bool(swept)
     chosen = [o.split("=", 1)[1] for o in fixed if o.startswith("experiment=")]
     experiments = [v.split("=", 1)[1] for v in swept.pop("experiment", [])] or chosen or [None]
     base = [o for o in fixed if not o.startswith("experiment=")]
@@ -338,7 +340,7 @@ def _variants(overrides: list[str]) -> list[tuple[str | None, list[str]]]:
     for experiment in experiments:
         variants.append((experiment, base))
         variants += [(experiment, [*base, value]) for values in swept.values() for value in values]
-    return variants
+    return variants, sweep or len(experiments) > 1
 
 
 def _one_line(err: Exception, overrides: list[str], valid_keys: list[str]) -> str:
@@ -363,27 +365,62 @@ def _listing(known: list[str]) -> str:
     return f"{len(known)} exist, e.g. {', '.join(known[:2])} (all: ls conf/experiment/*)"
 
 
-def compose_config(overrides: list[str]) -> DictConfig:
-    """The config Hydra would build for these overrides (no sweep syntax)."""
-    GlobalHydra.instance().clear()
-    with initialize_config_dir(config_dir=str(CONF_DIR), version_base=None):
-        return compose(config_name="config", overrides=overrides)
+def compose_config(overrides: list[str], with_hydra: bool = False) -> DictConfig:
+    """The config Hydra would build for these overrides (no sweep syntax); `with_hydra`: with its `hydra` node,
+    as Hydra hands it to a job (pipeline/__main__.py runs a single run on it without composing it again)."""
+    from hydra import compose, initialize_config_dir
+    from hydra.core.global_hydra import GlobalHydra
+
+    GlobalHydra.instance().clear()   # job name: the one @hydra.main gives `python -m pipeline`
+    with initialize_config_dir(config_dir=str(CONF_DIR), job_name="__main__", version_base=None):
+        return compose(config_name="config", overrides=overrides, return_hydra_config=with_hydra)
 
 
-def preflight(argv: list[str]) -> None:
-    """Refuse bad input before Hydra launches anything."""
+def _without_hydra(cfg: DictConfig) -> DictConfig:
+    """The job's config, as Hydra's run_job makes it: a copy without the `hydra` node."""
+    job = copy.deepcopy(cfg)
+    with open_dict(job):
+        del job["hydra"]
+    return job
+
+
+def compose_with_defaults(overrides: list[str]) -> tuple[DictConfig, DictConfig | None]:
+    """The config Hydra composes for `overrides` (with its `hydra` node), and the experiment's defaults: the
+    same composition just before Hydra applies the overrides' values, when every override but `experiment=` is
+    a value (none chooses a config group; else None). One composition where the checks would need two."""
+    from hydra._internal.config_loader_impl import ConfigLoaderImpl
+
+    apply = ConfigLoaderImpl._apply_overrides_to_config
+    before: list[tuple[int, DictConfig]] = []
+
+    def recording(values: list, cfg: DictConfig) -> None:
+        before.append((len(values), _without_hydra(cfg)))
+        apply(values, cfg)
+
+    ConfigLoaderImpl._apply_overrides_to_config = staticmethod(recording)
+    try:
+        composed = compose_config(overrides, with_hydra=True)
+    finally:
+        ConfigLoaderImpl._apply_overrides_to_config = staticmethod(apply)
+    values_only = len(before) == 1 and before[0][0] == len(overrides) - 1
+    return composed, before[0][1] if values_only else None
+
+
+def preflight(argv: list[str]) -> DictConfig | None:
+    """Refuse bad input before Hydra launches anything. Returns the checked config, with its `hydra` node, when
+    `argv` makes one job (no sweep), so that it need not be composed again."""
     if NO_PREFLIGHT_FLAGS.intersection(argv):
-        return
+        return None
     overrides = [a for a in argv if not a.startswith("-")]
     try:
-        variants = _variants(overrides)
+        variants, sweep = _variants(overrides)
     except BadInput:
         raise
     except Exception as err:  # the override syntax itself
         raise BadInput(f"cannot parse the overrides: {str(err).splitlines()[0]}") from None
 
     known = available_experiments()
-    checked: dict[str, tuple[DictConfig, list[str], Experiment]] = {}
+    checked: dict[str, tuple[DictConfig, Experiment]] = {}
     for experiment_id, extra in variants:
         if experiment_id is None:
             raise BadInput(f"choose an experiment: experiment=<slug>/<name>; {_listing(known)}")
@@ -399,18 +436,22 @@ def preflight(argv: list[str]) -> None:
             if o.startswith("+") and not o.startswith(("+hydra", "+episodes.randomize.")):
                 raise BadInput(f"adding keys is not allowed ('{o}'): every parameter has a default in conf/ "
                                "(only distributions are added: +episodes.randomize.<key>={uniform:[a,b]})")
-        if experiment_id not in checked:
-            defaults = compose_config([f"experiment={experiment_id}"])
-            checked[experiment_id] = (defaults, [k for k, _ in _leaves(defaults)], resolve(experiment_id))
-        defaults, valid_keys, experiment = checked[experiment_id]
         job_overrides = [f"experiment={experiment_id}", *(o for o in extra if not o.lstrip("+~").startswith("hydra"))]
-        try:
-            cfg = compose_config(job_overrides)
+        if not sweep:   # in the order given: Hydra records them (hydra.overrides.task)
+            job_overrides = [o for o in overrides if not o.lstrip("+~").startswith("hydra")]
+        try:   # one job: composed as @hydra.main composes a single run (it adds hydra.mode=RUN)
+            composed, defaults = compose_with_defaults(job_overrides + ([] if sweep else ["hydra.mode=RUN"]))
         except Exception as err:
-            raise BadInput(_one_line(err, job_overrides, valid_keys)) from None
+            defaults = compose_config([f"experiment={experiment_id}"])
+            raise BadInput(_one_line(err, job_overrides, [k for k, _ in _leaves(defaults)])) from None
+        cfg = _without_hydra(composed)
+        if experiment_id not in checked:
+            checked[experiment_id] = (defaults or compose_config([f"experiment={experiment_id}"]),
+                                      resolve(experiment_id))
+        defaults, experiment = checked[experiment_id]
         check_data_dir(cfg.data_dir)
         check_config(cfg, defaults, experiment.limits)
         check_rules(cfg, experiment)
         check_cases(cfg, experiment)
         check_episodes(cfg, experiment)
-    GlobalHydra.instance().clear()
+    return None if sweep else composed   # (each composition leaves Hydra uninitialised, as it found it)

@@ -19,15 +19,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
-from mcap.reader import make_reader
-from mcap.records import Chunk
-from mcap.stream_reader import ReadDataStream, get_chunk_data_stream
-from mcap_protobuf.decoder import DecoderFactory
 
 from pipeline.core import robot
 from pipeline.core.encoding import series_layout
 
-if TYPE_CHECKING:  # imported where frames are built: the simulate stage never builds one
+if TYPE_CHECKING:  # imported where frames are built: the simulate stage never builds one (nor reads MCAP)
     import pandas as pd
 
 MESSAGE_OPCODE = 0x05
@@ -160,6 +156,9 @@ def _has(message: Message, fd: FieldDescriptor) -> bool:
 
 
 def _chunks(f, summary, channel: int) -> Iterable[bytes]:
+    from mcap.records import Chunk
+    from mcap.stream_reader import ReadDataStream, get_chunk_data_stream
+
     for index in sorted(summary.chunk_indexes, key=lambda i: i.chunk_start_offset):
         if channel in index.message_index_offsets:
             f.seek(index.chunk_start_offset + 9)  # past the record's opcode (1 byte) and length (8)
@@ -243,6 +242,9 @@ class _Ros2StringDecoder:
 def read_topics(path: str | Path, topics: Iterable[str], arrays: bool = True) -> dict[str, pd.DataFrame]:
     """Topic -> DataFrame indexed by simulated time `t` (s), for each of `topics` the file has. `arrays=False`
     decodes every message with protobuf (the general path; the benchmark compares the two)."""
+    from mcap.reader import make_reader
+    from mcap_protobuf.decoder import DecoderFactory
+
     wanted = set(topics)
     frames: dict[str, pd.DataFrame] = {}
     factories = (DecoderFactory(), _Ros2StringDecoder())

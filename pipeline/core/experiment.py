@@ -28,9 +28,9 @@ from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING
 
-from omegaconf import DictConfig
+if TYPE_CHECKING:  # the run-file machinery (pandas, MCAP), and OmegaConf, are not needed to find an experiment
+    from omegaconf import DictConfig
 
-if TYPE_CHECKING:  # the run-file machinery (pandas, MCAP) is not needed to find an experiment
     from pipeline.core.runlog import RunWriter
 
 CONF_DIR = Path(__file__).resolve().parents[2] / "conf"
@@ -47,7 +47,7 @@ class Case:
     shares_work: bool = False
 
 
-ExperimentFn = Callable[[DictConfig], list[Case]]
+ExperimentFn = Callable[["DictConfig"], list[Case]]
 
 
 @dataclass(frozen=True)

@@ -23,9 +23,6 @@ from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 from google.protobuf import descriptor_pb2
 from google.protobuf.descriptor import Descriptor
 from google.protobuf.message import Message
-from mcap.reader import make_reader
-from mcap.records import Chunk
-from mcap.stream_reader import ReadDataStream, get_chunk_data_stream
 
 from pipeline.core import files, layouts, markers, robot, schemas
 from pipeline.core.decoding import entry_labels, read_topics
@@ -445,6 +442,8 @@ class Run:
     simulated time `t` in s), decoded the first time it is asked for."""
 
     def __init__(self, path: str | Path):
+        from mcap.reader import make_reader  # the MCAP reader: not imported by a simulate stage
+
         self.path = Path(path)
         with open(self.path, "rb") as f:
             reader = make_reader(f)
@@ -470,6 +469,10 @@ class Run:
     def verify(self) -> Run:
         """Decompress every chunk and check its CRC: a damaged file fails here, not halfway through an
         analysis (C-speed decompression, no message decoding)."""
+        from mcap.reader import make_reader
+        from mcap.records import Chunk
+        from mcap.stream_reader import ReadDataStream, get_chunk_data_stream
+
         with open(self.path, "rb") as f:
             summary = make_reader(f).get_summary()
             if summary is None:

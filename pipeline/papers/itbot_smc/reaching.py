@@ -18,8 +18,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import integrate, optimize
 
+# scipy (0.3 s to import) is imported by the reaching-time functions: a controller needs only the laws
 LAWS = ("smc", "smerl", "nsmerl")
 TINY = float(np.finfo(float).tiny)
 
@@ -105,6 +105,8 @@ def reaching_time(law, v0: float, g: LawGains, horizon: float = 1e3, rtol: float
     event at |v| = 1e-12 |v0| (the definition; `reaching_times` is the fast form). The last 1e-12 |v0| is left
     out: a law like |v|^ϕ sign(v) is not Lipschitz at 0, where the step control would stall. NaN if not reached
     within `horizon` s."""
+    from scipy import integrate
+
     if v0 == 0:
         return 0.0
     end = 1e-12 * abs(v0)
@@ -125,6 +127,8 @@ def reaching_times(v0: float, g: LawGains) -> dict[str, float]:
     than v(t): for the autonomous laws T = ∫_0^v0 dv / |r(v)| by quadrature; for nSMERL, whose ω-term depends on
     t, the ODE dt/dv = 1/r(v, t) from v0 down to 0 (its right side stays bounded: |r| ≥ ω(t) K (1 − ϕ)/φ). Equal to
     `reaching_time` (tests) at a fraction of its cost."""
+    from scipy import integrate
+
     def inverse_rate(law):
         return lambda v: -1.0 / law(v, 0.0, g, math)
 
@@ -146,6 +150,8 @@ def crossover(g: LawGains, bracket: tuple[float, float], switching: bool = True)
     """The largest |v(0)| in `bracket` at which nSMERL (with or without its ω-term) and ERL take equally long to
     reach v = 0: above it nSMERL is faster. The lower end if nSMERL is faster over the whole bracket, NaN if
     it is slower at the upper end. Found by scanning a log grid, then Brent's method on the last sign change."""
+    from scipy import optimize
+
     name = "nsmerl" if switching else "nsmerl_no_switching"
 
     def gap(v0: float) -> float:
@@ -165,6 +171,8 @@ def crossover(g: LawGains, bracket: tuple[float, float], switching: bool = True)
 
 def erl_reaching_time(v0: float, K: float, phi: float, alpha: float, p: float) -> float:
     """Eq. (7): (φ|v0| + (1 − φ) ∫_0^|v0| exp(−α v^p) dv) / K (ERL, exact)."""
+    from scipy import integrate
+
     integral, _ = integrate.quad(lambda v: math.exp(-alpha * v ** p), 0.0, abs(v0), epsabs=1e-13, epsrel=1e-12)
     return (phi * abs(v0) + (1 - phi) * integral) / K
 
