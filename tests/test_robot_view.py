@@ -17,7 +17,7 @@ from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
 
 from pipeline.core import layouts, robot
 from pipeline.core.runlog import RunWriter, read_run
-from pipeline.robotics.urdf import Pose, _quat_mul, _rotate, describe
+from pipeline.robotics.urdf import Pose, _euler, _quat_mul, _rotate, describe
 
 from .conftest import ENV
 
@@ -318,3 +318,19 @@ def test_one_pose_composed_on_floats_equals_the_batched_arithmetic():
         a, b = (Pose(rng.standard_normal(3), rng.standard_normal(4)) for _ in range(2))
         c = a @ b
         assert np.array_equal(c.p, a.p + _rotate(a.q, b.p)) and np.array_equal(c.q, _quat_mul(a.q, b.q))
+
+
+@pytest.mark.parametrize("sequence", ["xyz", "XYZ"])
+def test_euler_angles_give_back_the_rotation(sequence):
+    """URDF rpy and the moving-axis triple of a ball joint: the angles rebuild each quaternion's rotation, at
+    random rotations and at gimbal lock (middle angle ±π/2), and equal SciPy's away from it."""
+    from scipy.spatial.transform import Rotation
+
+    rotations = Rotation.concatenate([Rotation.random(2000, random_state=3)] + [
+        Rotation.from_euler(sequence, [[0.3, s * np.pi / 2, 0.2], [-2.0, s * np.pi / 2, 0.0]]) for s in (1, -1)])
+    quats = rotations.as_quat(scalar_first=True)
+    angles = _euler(quats, sequence)
+    assert np.abs(Rotation.from_euler(sequence, angles).as_matrix() - rotations.as_matrix()).max() < 1e-13
+    assert np.abs(angles[:2000] - rotations[:2000].as_euler(sequence)).max() < 1e-12
+    with pytest.raises(ValueError, match="Euler sequence"):
+        _euler(quats, "zyx")
