@@ -249,7 +249,11 @@ def _frame(times: np.ndarray, columns: dict[str, Any]) -> pd.DataFrame:
     import pandas as pd
 
     index = pd.Index(times.astype(np.int64) / 1e9, name="t")
-    frame = pd.DataFrame(columns, index=index)
+    values = list(columns.values())
+    if values and all(isinstance(v, np.ndarray) and v.dtype == np.float64 for v in values):
+        frame = pd.DataFrame(np.stack(values).T, columns=list(columns), index=index, copy=False)  # one block
+    else:
+        frame = pd.DataFrame(columns, index=index)
     return frame if index.is_monotonic_increasing else frame.sort_index(kind="stable")
 
 
