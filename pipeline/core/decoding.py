@@ -1,12 +1,17 @@
 """Read a run's topics back into DataFrames, column by column in NumPy where the messages allow it.
 
-A topic's messages are found through the chunk's message index (or, in a file without one, by walking its
-records) and decoded together by pipeline.core.wire: every field of every message in one NumPy step per
-field. Anything that decoder does not read exactly (fields out of order, unknown fields, another writer's
-quirks) is decoded message by message with protobuf, and so is a topic whose columns, on the messages where
-they first appear and on the last one, differ from protobuf's. Both paths give the same columns: a repeated
-field labelled by the message's `name` list becomes `field.<name>`, else `field[i]`; a repeated message
-becomes `field.<child_frame_id or name or i>.<subfield>`; an optional scalar left out is no column.
+A topic's messages are located through each chunk's message index (or, in a file without one, by walking the
+chunk's records), then read by the first of three paths that applies:
+- a series of doubles with one fixed byte layout (pipeline.core.encoding), every message checked byte for byte
+  against the first one's tags, lengths and constant fields, is one structured NumPy view of the chunk;
+- any other protobuf topic of at least MIN_COLUMNAR messages is decoded field by field over all messages at
+  once (pipeline.core.wire), and its columns must equal protobuf's on the messages where they first appear
+  and on the last one;
+- anything else (fields out of order, unknown fields, another writer's quirks, a damaged message) is decoded
+  message by message with protobuf, which is also the reference the tests hold the fast paths to.
+All paths give the same columns: a repeated field labelled by the message's `name` list becomes `field.<name>`,
+else `field[i]`; a repeated message becomes `field.<child_frame_id or name or i>.<subfield>`; an optional scalar
+left out is no column.
 """
 
 from __future__ import annotations
@@ -233,8 +238,8 @@ def _series(first: Message, buf: np.ndarray, starts: np.ndarray, ends: np.ndarra
     for column, value in row0.items():
         field = column.split(".", 1)[0].split("[", 1)[0]
         if field not in doubles:
-            columns[column] = np.full(n, value) if not isinstance(value, str) else \
-                _values(wire.Column(column, None, wire.Texts(np.zeros(n, np.int64), np.array([value], object))), n)
+            columns[column] = _values(wire.Column(column, None, wire.Texts(np.zeros(n, np.int64), np.array(
+                [value], dtype=object))), n) if isinstance(value, str) else np.full(n, value)
     for field in layout.doubles:
         values = records[field]
         if values.ndim == 1:

@@ -22,7 +22,7 @@ PAD = 16  # zero bytes after the last message: a varint read near the end never 
 MAX_DEPTH = 32
 
 _T = FieldDescriptor
-# field type -> (wire type, NumPy dtype of a fixed-width value, or None for a varint)
+# field type -> NumPy dtype of its fixed-width value
 _FIXED = {_T.TYPE_DOUBLE: "<f8", _T.TYPE_FIXED64: "<u8", _T.TYPE_SFIXED64: "<i8", _T.TYPE_FLOAT: "<f4",
           _T.TYPE_FIXED32: "<u4", _T.TYPE_SFIXED32: "<i4"}
 _VARINT = {_T.TYPE_INT64, _T.TYPE_UINT64, _T.TYPE_INT32, _T.TYPE_UINT32, _T.TYPE_SINT32, _T.TYPE_SINT64,
@@ -110,7 +110,7 @@ def _fixed(buf: np.ndarray, pos: np.ndarray, dtype: str) -> np.ndarray:
 
 
 def _scalars(fd: FieldDescriptor, buf: np.ndarray, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Values of field `fd` at `pos` (NumPy, or object arrays of str/bytes) and the bytes each takes."""
+    """Values of numeric field `fd` at `pos` and the bytes each takes."""
     if fd.type in _FIXED:
         dtype = _FIXED[fd.type]
         values = _fixed(buf, pos, dtype)
@@ -127,10 +127,6 @@ def _scalars(fd: FieldDescriptor, buf: np.ndarray, pos: np.ndarray) -> tuple[np.
             raise Irregular("uint64 beyond int64")
         values = raw.view(np.int64)
         return (values.astype(np.int32).astype(np.int64) if fd.type == _T.TYPE_INT32 else values), size
-    if fd.type in _BYTES:
-        length, size = _varint(buf, pos)
-        length = length.astype(np.int64)
-        return _texts(buf, pos + size, length, fd.type == _T.TYPE_STRING), size + length
     raise Irregular(f"field type {fd.type}")
 
 
@@ -234,6 +230,8 @@ def columns(desc: Descriptor, buf: np.ndarray, start: np.ndarray, end: np.ndarra
     tag, size = _tags(buf, pos, pos < end)  # at each message's position
     name_fd = desc.fields_by_name.get("name")
     labelled = name_fd is not None and _repeated(name_fd)
+    if labelled and name_fd.type != _T.TYPE_STRING:
+        raise Irregular(f"{desc.full_name}: names that are not strings")
     out: list[Column] = []
     repeated_scalars: list[tuple[FieldDescriptor, tuple]] = []
     names: tuple | None = None
@@ -342,16 +340,16 @@ def _labelled_entries(field: str, m: int, entries: tuple, names: tuple | None, l
     owner, k, values, per_entry = entries
     if per_entry is not None:  # as many entries in every message, and names (if any) alike in every one
         same_names = None
-        if names is None:
-            same_names = [] if labelled else None
+        if not labelled or not len(names[0]):
+            same_names = []
         elif names[3] is not None and all(len(t.unique) == 1 for t in names[3]):
             same_names = [t.unique[0] for t in names[3]]
         if same_names is not None and len(set(same_names)) == len(same_names):
             labels = [f".{n}" for n in same_names] if len(same_names) == len(per_entry) else \
                 [f"[{j}]" for j in range(len(per_entry))]
             return [Column(field + label, None, v) for label, v in zip(labels, per_entry, strict=True)]
-    codes = -(k + 1)  # below 0: the index; from 0: the code of a name
-    if names is not None and len(owner):
+    codes, texts = -(k + 1), []  # codes below 0: the index; from 0: the code of a name
+    if labelled and len(owner):
         name_owner, name_k, name_texts, _ = names
         named = (np.bincount(name_owner, minlength=m) == np.bincount(owner, minlength=m))[owner]
         if named.any():
