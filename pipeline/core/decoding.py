@@ -39,7 +39,6 @@ MESSAGE_OPCODE = 0x05
 MESSAGE_INDEX_OPCODE = 0x07
 MAX_FIRST_ROWS = 64  # columns that first appear in more messages than this: decoded message by message
 MIN_COLUMNAR = 32  # fewer messages than this: protobuf decodes them faster than NumPy steps per field
-_MISSING = object()
 # opcode, record length, then the Message record's channel id, sequence, log time and publish time
 RECORD_HEADER = [("op", "u1"), ("length", "<u8"), ("channel", "<u2"), ("sequence", "<u4"), ("log_time", "<u8"),
                  ("publish_time", "<u8")]
@@ -270,19 +269,33 @@ def _text_dtype() -> Any:
     return pd.Series(["a"]).dtype
 
 
+@functools.lru_cache(maxsize=1024)
+def _constant_text(text: str, n: int) -> Any:
+    """n times `text` as a pandas string array (never modified: pandas copies on write)."""
+    import pandas as pd
+    import pyarrow as pa
+
+    return pd.array(pa.array([text], pa.large_string()).take(pa.array(np.zeros(n, np.int32))), dtype=_text_dtype())
+
+
 def _values(column: wire.Column, n: int) -> Any:
     """A column over all n rows: NaN where a message has no value, as pandas makes of protobuf's rows."""
     values = column.values
     dense = column.rows is None or len(column.rows) == n
     if isinstance(values, wire.Texts):
         unique = values.unique.tolist()
-        if dense and getattr(_text_dtype(), "storage", None) == "pyarrow" and all(isinstance(u, str) for u in unique):
+        if getattr(_text_dtype(), "storage", None) == "pyarrow" and all(isinstance(u, str) for u in unique):
+            if dense and len(unique) == 1:  # a frame id, a joint's name: the same column in every file
+                return _constant_text(unique[0], n)
             import pandas as pd
             import pyarrow as pa
 
-            texts = pa.DictionaryArray.from_arrays(pa.array(values.codes.astype(np.int32)),
-                                                   pa.array(unique, pa.large_string()))
-            return pd.array(texts.dictionary_decode(), dtype=_text_dtype())  # no Python string per row
+            codes = values.codes.astype(np.int32)
+            if not dense:
+                codes = np.full(n, -1, np.int32)
+                codes[column.rows] = values.codes
+            texts = pa.DictionaryArray.from_arrays(pa.array(codes, mask=codes < 0), pa.array(unique, pa.large_string()))
+            return pd.array(texts.dictionary_decode(), dtype=_text_dtype())  # no Python string per row; NaN where none
         values = values.objects()
     if dense:
         return values
@@ -311,12 +324,10 @@ def _columnar(cls: type[Message], buf: np.ndarray, starts: np.ndarray, ends: np.
     if len(columns) != len([c for c in found if c.rows is None or len(c.rows)]):
         return None  # two fields flatten to one name: protobuf's rows say which wins
 
+    dense = {name for name, c in columns.items() if c.rows is None or len(c.rows) == n}
+    sparse = {name: c for name, c in columns.items() if name not in dense}
+
     def value(column: wire.Column, row: int) -> Any:
-        if column.rows is not None:
-            at = int(np.searchsorted(column.rows, row))
-            if at == len(column.rows) or column.rows[at] != row:
-                return _MISSING
-            row = at
         values = column.values
         return values.unique[values.codes[row]] if isinstance(values, wire.Texts) else values[row].item()
 
@@ -324,12 +335,20 @@ def _columnar(cls: type[Message], buf: np.ndarray, starts: np.ndarray, ends: np.
     rows = sorted(set(first.values()))
     if len(rows) > MAX_FIRST_ROWS:
         return None
+    checked = np.array([*rows, n - 1])
+    where, by_rows = {}, {}  # sparse column -> (index of each checked row in its rows, or -1)
+    for name, c in sparse.items():
+        if id(c.rows) not in by_rows:  # the subfields of one repeated entry share their rows
+            at = np.minimum(np.searchsorted(c.rows, checked), len(c.rows) - 1)
+            by_rows[id(c.rows)] = np.where(c.rows[at] == checked, at, -1).tolist()
+        where[name] = by_rows[id(c.rows)]
     order: dict[str, None] = {}
-    for row in [*rows, n - 1]:
+    for i, row in enumerate(checked.tolist()):
         expected: dict[str, Any] = {}
         flatten(cls.FromString(buf[starts[row]:ends[row]].tobytes()), "", expected)
-        present = {name for name, c in columns.items() if value(c, row) is not _MISSING}
-        if set(expected) != present or not all(_same(value(columns[k], row), v) for k, v in expected.items()):
+        at = {name: w[i] for name, w in where.items() if w[i] >= 0}
+        if len(expected) != len(dense) + len(at) or not all(
+                (k in dense or k in at) and _same(value(columns[k], at.get(k, row)), v) for k, v in expected.items()):
             return None
         order.update(dict.fromkeys(expected))
     if len(order) != len(columns):
