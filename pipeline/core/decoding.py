@@ -1,12 +1,17 @@
-"""Read a run's topics back into DataFrames, at NumPy speed where the messages allow it.
+"""Read a run's topics back into DataFrames, column by column in NumPy where the messages allow it.
 
-The writer logs each topic in chunks of its own, and series of doubles with one fixed byte layout
-(pipeline.core.encoding). Such a chunk is an array of equal records: MCAP's message header, then the message
-with its double fields at fixed offsets. One structured NumPy view reads them all, after checking every record's
-header, channel, field tags and constant fields against the first message (decoded by protobuf). Anything else
-(nested messages, strings that change, fields that come and go, another writer's files) is decoded message by
-message. Both paths give the same columns: a repeated field labelled by the message's `name` list becomes
-`field.<name>`, else `field[i]`; a repeated message becomes `field.<child_frame_id or name or i>.<subfield>`.
+A topic's messages are located through each chunk's message index (or, in a file without one, by walking the
+chunk's records), then read by the first of three paths that applies:
+- a series of doubles with one fixed byte layout (pipeline.core.encoding), every message checked byte for byte
+  against the first one's tags, lengths and constant fields, is one structured NumPy view of the chunk;
+- any other protobuf topic of at least MIN_COLUMNAR messages is decoded field by field over all messages at
+  once (pipeline.core.wire), and its columns must equal protobuf's on the messages where they first appear
+  and on the last one;
+- anything else (fields out of order, unknown fields, another writer's quirks, a damaged message) is decoded
+  message by message with protobuf, which is also the reference the tests hold the fast paths to.
+All paths give the same columns: a repeated field labelled by the message's `name` list becomes `field.<name>`,
+else `field[i]`; a repeated message becomes `field.<child_frame_id or name or i>.<subfield>`; an optional scalar
+left out is no column.
 """
 
 from __future__ import annotations
@@ -20,13 +25,16 @@ import numpy as np
 from google.protobuf.descriptor import Descriptor, FieldDescriptor
 from google.protobuf.message import Message
 
-from pipeline.core import robot
+from pipeline.core import robot, wire
 from pipeline.core.encoding import series_layout
 
 if TYPE_CHECKING:  # imported where frames are built: the simulate stage never builds one (nor reads MCAP)
     import pandas as pd
 
 MESSAGE_OPCODE = 0x05
+MESSAGE_INDEX_OPCODE = 0x07
+MAX_FIRST_ROWS = 64  # columns that first appear in more messages than this: decoded message by message
+MIN_COLUMNAR = 32  # fewer messages than this: protobuf decodes them faster than NumPy steps per field
 # opcode, record length, then the Message record's channel id, sequence, log time and publish time
 RECORD_HEADER = [("op", "u1"), ("length", "<u8"), ("channel", "<u2"), ("sequence", "<u4"), ("log_time", "<u8"),
                  ("publish_time", "<u8")]
@@ -83,26 +91,81 @@ def entry_labels(field: str, count: int, names: list[str] | None) -> list[str]:
     return [f"{field}[{i}]" for i in range(count)]
 
 
-def _walk(data: bytes, channel: int, first_only: bool = False) -> tuple[int, list[tuple[int, bytes]]]:
-    """(offset of the channel's first message record or -1, [(log time, payload)] of its messages): the general,
-    record-by-record walk of a chunk."""
-    pos, first, found = 0, -1, []
+def _chunk_data(f, index) -> bytes:
+    from mcap.records import Chunk
+    from mcap.stream_reader import ReadDataStream, get_chunk_data_stream
+
+    f.seek(index.chunk_start_offset + 9)  # past the record's opcode (1 byte) and length (8)
+    chunk = Chunk.read(ReadDataStream(f))
+    if chunk.compression == "lz4":  # the writer's: decompressed straight into one bytes object
+        import lz4.frame
+
+        data = lz4.frame.decompress(chunk.data)
+    else:
+        stream, length = get_chunk_data_stream(chunk)
+        data = stream.read(length)
+    if len(data) != chunk.uncompressed_size:
+        raise ValueError(f"a chunk decompresses to {len(data)} bytes, its record says {chunk.uncompressed_size}")
+    return data
+
+
+def _indexed_offsets(f, index, channel: int) -> np.ndarray | None:
+    """Offsets of the channel's message records in a chunk, from the chunk's message index (None if it has none)."""
+    offset = index.message_index_offsets.get(channel)
+    if offset is None:
+        return None
+    f.seek(offset)
+    head = f.read(15)  # opcode, record length, channel id, byte length of the (log time, offset) array
+    if len(head) < 15 or head[0] != MESSAGE_INDEX_OPCODE or int.from_bytes(head[9:11], "little") != channel:
+        return None
+    entries = np.frombuffer(f.read(int.from_bytes(head[11:15], "little")), dtype=[("t", "<u8"), ("offset", "<u8")])
+    return np.sort(entries["offset"]).astype(np.int64)
+
+
+def _walked_offsets(data: bytes, channel: int) -> np.ndarray:
+    """Offsets of the channel's message records in a chunk, record by record (a file without message indexes)."""
+    pos, found = 0, []
     view = memoryview(data)
     while pos + 9 <= len(data):
-        length = int.from_bytes(view[pos + 1:pos + 9], "little")
         if data[pos] == MESSAGE_OPCODE and int.from_bytes(view[pos + 9:pos + 11], "little") == channel:
-            if first < 0:
-                first = pos
-            found.append((int.from_bytes(view[pos + 15:pos + 23], "little"),
-                          bytes(view[pos + 9 + CONTENT_HEADER_BYTES:pos + 9 + length])))
-            if first_only:
-                break
-        pos += 9 + length
-    return first, found
+            found.append(pos)
+        pos += 9 + int.from_bytes(view[pos + 1:pos + 9], "little")
+    return np.array(found, dtype=np.int64)
+
+
+def _messages(f, summary, channel: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(bytes of the chunks, payload starts, payload ends, log times) of a channel's messages in file order."""
+    parts, starts, ends, times = [], [], [], []
+    base = 0
+    for index in sorted(summary.chunk_indexes, key=lambda i: i.chunk_start_offset):
+        if index.message_index_offsets and channel not in index.message_index_offsets:
+            continue  # a chunk without message indexes may hold any channel: it is walked
+        offsets = _indexed_offsets(f, index, channel)
+        data = _chunk_data(f, index)
+        if offsets is None:
+            offsets = _walked_offsets(data, channel)
+        chunk = np.frombuffer(data, dtype=np.uint8)
+        if len(offsets) and offsets[-1] + HEADER_BYTES > len(chunk):
+            raise ValueError(f"message index points past the end of a chunk of channel {channel}")
+        head = np.ndarray((len(chunk) - HEADER_BYTES + 1,), dtype=RECORD_HEADER, buffer=chunk, strides=(1,))[offsets]
+        stop = offsets + 9 + head["length"].astype(np.int64)
+        if not ((head["op"] == MESSAGE_OPCODE).all() and (head["channel"] == channel).all()
+                and (head["length"] >= CONTENT_HEADER_BYTES).all() and (stop <= len(chunk)).all()):
+            raise ValueError(f"a chunk's message records of channel {channel} do not match its message index")
+        parts.append(data)
+        starts.append(base + offsets + HEADER_BYTES)
+        ends.append(base + stop)
+        times.append(head["log_time"])
+        base += len(data)
+    buf = np.frombuffer(b"".join([*parts, bytes(wire.PAD)]), dtype=np.uint8)
+    empty = np.zeros(0, np.int64)
+    return (buf, np.concatenate(starts) if starts else empty, np.concatenate(ends) if ends else empty,
+            np.concatenate(times).astype(np.int64) if times else empty)
 
 
 class _Layout:
-    """The fixed layout of a flat message, learnt from its first instance, as a record dtype."""
+    """The fixed byte layout of a flat series of doubles (pipeline.core.encoding), learnt from its first message
+    and checked byte for byte against it."""
 
     def __init__(self, cls: type[Message], first: Message, payload: bytes):
         self.ok = False
@@ -129,25 +192,26 @@ class _Layout:
             if record.tobytes() == payload:
                 self.ok = True
                 self.message = dtype
-                self.record = np.dtype(RECORD_HEADER + [(n, *dtype.fields[n][:1]) for n in dtype.names])
                 self.fixed = [n for n in dtype.names if n.startswith(("c_", "h_"))]
                 self.doubles = [f for f, *_ in fields if f in per_sample]
                 return
 
-    def read(self, data: bytes, start: int, channel: int, reference: np.ndarray | None) -> np.ndarray | None:
-        """The records of one chunk from `start` as one array, or None if they are not all this layout."""
-        stride = self.record.itemsize
-        if (len(data) - start) % stride:
+    def read(self, buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray | None:
+        """The messages as one record array (views of the chunks' equal, back-to-back records), or None if
+        they are not all of this layout."""
+        size = self.message.itemsize
+        if (ends - starts != size).any():
             return None
-        records = np.frombuffer(data, dtype=self.record, offset=start, count=(len(data) - start) // stride)
-        if not ((records["op"] == MESSAGE_OPCODE).all() and (records["length"] == stride - 9).all()
-                and (records["channel"] == channel).all()):
+        breaks = np.flatnonzero(np.diff(starts) != size + HEADER_BYTES) + 1  # chunk boundaries
+        if len(breaks) > len(starts) // 16:  # records of other channels in between (another writer's chunks)
             return None
-        reference = records[:1] if reference is None else reference
-        for name in self.fixed:  # tags, lengths and constant fields: the same bytes in every record
-            if not (records[name] == reference[name][0]).all():
+        blocks = [np.ndarray((b - a,), dtype=self.message, buffer=buf, offset=int(starts[a]),
+                             strides=(size + HEADER_BYTES,))
+                  for a, b in zip([0, *breaks.tolist()], [*breaks.tolist(), len(starts)], strict=True)]
+        for name in self.fixed:  # tags, lengths and constant fields: the same bytes in every message
+            if not all((block[name] == blocks[0][name][0]).all() for block in blocks):
                 return None
-        return records
+        return blocks[0] if len(blocks) == 1 else np.concatenate(blocks)
 
 
 def _has(message: Message, fd: FieldDescriptor) -> bool:
@@ -155,59 +219,13 @@ def _has(message: Message, fd: FieldDescriptor) -> bool:
     return len(value) > 0 if _is_repeated(fd) else value != fd.default_value
 
 
-def _chunks(f, summary, channel: int) -> Iterable[bytes]:
-    from mcap.records import Chunk
-    from mcap.stream_reader import ReadDataStream, get_chunk_data_stream
-
-    for index in sorted(summary.chunk_indexes, key=lambda i: i.chunk_start_offset):
-        if channel in index.message_index_offsets:
-            f.seek(index.chunk_start_offset + 9)  # past the record's opcode (1 byte) and length (8)
-            stream, length = get_chunk_data_stream(Chunk.read(ReadDataStream(f)))
-            yield stream.read(length)
-
-
-def _frame(times: np.ndarray, rows: dict[str, Any]) -> pd.DataFrame:
-    import pandas as pd
-
-    index = pd.Index(times.astype(np.int64) / 1e9, name="t")
-    return pd.DataFrame(rows, index=index).sort_index(kind="stable")
-
-
-def _read_topic(f, summary, channel_id: int, decode, arrays: bool = True) -> pd.DataFrame | None:
-    import pandas as pd
-
-    chunks = list(_chunks(f, summary, channel_id))
-    starts = [_walk(data, channel_id, first_only=True) for data in chunks]
-    payload = next((found[0][1] for _, found in starts if found), None)
-    if payload is None:
+def _series(first: Message, buf: np.ndarray, starts: np.ndarray, ends: np.ndarray,
+            times: np.ndarray) -> pd.DataFrame | None:
+    """A flat series of doubles of one fixed layout read as one record array, or None."""
+    layout = _Layout(type(first), first, buf[starts[0]:ends[0]].tobytes())
+    records = layout.read(buf, starts, ends) if layout.ok else None
+    if records is None:
         return None
-    first = decode(payload)
-    layout = _Layout(type(first), first, payload) if arrays and isinstance(first, Message) else None
-    if layout is not None and layout.ok:
-        blocks, reference = [], None
-        for data, (start, _) in zip(chunks, starts, strict=True):
-            block = layout.read(data, start, channel_id, reference) if start >= 0 else None
-            if block is None:
-                break
-            reference = block[:1] if reference is None else reference
-            blocks.append(block)
-        else:
-            return _fast_frame(np.concatenate(blocks), layout, first)
-    messages = [m for data in chunks for m in _walk(data, channel_id)[1]]
-    rows = []
-    for _, data in messages:
-        decoded, row = decode(data), {}
-        if isinstance(decoded, dict):
-            row.update(decoded)
-        else:
-            flatten(decoded, "", row)
-        rows.append(row)
-    index = pd.Index(np.array([t for t, _ in messages], dtype=np.int64) / 1e9, name="t")
-    return pd.DataFrame.from_records(rows, index=index).sort_index(kind="stable")
-
-
-def _fast_frame(records: np.ndarray, layout: _Layout, first: Message) -> pd.DataFrame:
-
     row0: dict[str, Any] = {}
     flatten(first, "", row0)
     labelled, _ = _plan(first.DESCRIPTOR)
@@ -218,7 +236,8 @@ def _fast_frame(records: np.ndarray, layout: _Layout, first: Message) -> pd.Data
     for column, value in row0.items():
         field = column.split(".", 1)[0].split("[", 1)[0]
         if field not in doubles:
-            columns[column] = np.full(n, value) if not isinstance(value, str) else [value] * n
+            columns[column] = _values(wire.Column(column, None, wire.Texts(np.zeros(n, np.int64), np.array(
+                [value], dtype=object))), n) if isinstance(value, str) else np.full(n, value)
     for field in layout.doubles:
         values = records[field]
         if values.ndim == 1:
@@ -226,8 +245,139 @@ def _fast_frame(records: np.ndarray, layout: _Layout, first: Message) -> pd.Data
         else:
             for i, label in enumerate(entry_labels(field, values.shape[1], names)):
                 columns[label] = values[:, i].astype(float, copy=True)
-    ordered = {c: columns[c] for c in row0 if c in columns}
-    return _frame(records["log_time"], ordered)
+    return _frame(times, {c: columns[c] for c in row0 if c in columns})
+
+
+def _frame(times: np.ndarray, columns: dict[str, Any]) -> pd.DataFrame:
+    import pandas as pd
+
+    index = pd.Index(times.astype(np.int64) / 1e9, name="t")
+    values = list(columns.values())
+    if values and all(isinstance(v, np.ndarray) and v.dtype == np.float64 for v in values):
+        frame = pd.DataFrame(np.stack(values).T, columns=list(columns), index=index, copy=False)  # one block
+    else:
+        frame = pd.DataFrame(columns, index=index)
+    return frame if index.is_monotonic_increasing else frame.sort_index(kind="stable")
+
+
+@functools.cache
+def _text_dtype() -> Any:
+    """The dtype pandas gives a column of Python strings (pandas 3: `str`, stored in Arrow)."""
+    import pandas as pd
+
+    return pd.Series(["a"]).dtype
+
+
+@functools.lru_cache(maxsize=1024)
+def _constant_text(text: str, n: int) -> Any:
+    """n times `text` as a pandas string array (never modified: pandas copies on write)."""
+    import pandas as pd
+    import pyarrow as pa
+
+    return pd.array(pa.array([text], pa.large_string()).take(pa.array(np.zeros(n, np.int32))), dtype=_text_dtype())
+
+
+def _values(column: wire.Column, n: int) -> Any:
+    """A column over all n rows: NaN where a message has no value, as pandas makes of protobuf's rows."""
+    values = column.values
+    dense = column.rows is None or len(column.rows) == n
+    if isinstance(values, wire.Texts):
+        unique = values.unique.tolist()
+        if getattr(_text_dtype(), "storage", None) == "pyarrow" and all(isinstance(u, str) for u in unique):
+            if dense and len(unique) == 1:  # a frame id, a joint's name: the same column in every file
+                return _constant_text(unique[0], n)
+            import pandas as pd
+            import pyarrow as pa
+
+            codes = values.codes.astype(np.int32)
+            if not dense:
+                codes = np.full(n, -1, np.int32)
+                codes[column.rows] = values.codes
+            texts = pa.DictionaryArray.from_arrays(pa.array(codes, mask=codes < 0), pa.array(unique, pa.large_string()))
+            return pd.array(texts.dictionary_decode(), dtype=_text_dtype())  # no Python string per row; NaN where none
+        values = values.objects()
+    if dense:
+        return values
+    full = np.full(n, np.nan, dtype=float if values.dtype.kind in "fiu" else object)
+    full[column.rows] = values
+    return full
+
+
+def _same(a: Any, b: Any) -> bool:
+    return a == b or (isinstance(a, float) and isinstance(b, float) and a != a and b != b)
+
+
+def _columnar(cls: type[Message], buf: np.ndarray, starts: np.ndarray, ends: np.ndarray,
+              times: np.ndarray) -> pd.DataFrame | None:
+    """The topic decoded column by column (pipeline.core.wire), or None where that does not apply.
+
+    The columns are ordered as pandas orders protobuf's rows (first appearance), read off the first message
+    in which each column appears; those messages and the last one are also decoded by protobuf and must hold
+    exactly the same values."""
+    try:
+        found = wire.columns(cls.DESCRIPTOR, buf, starts, ends)
+    except wire.Irregular:
+        return None
+    n = len(starts)
+    columns = {c.name: c for c in found if c.rows is None or len(c.rows)}
+    if len(columns) != len([c for c in found if c.rows is None or len(c.rows)]):
+        return None  # two fields flatten to one name: protobuf's rows say which wins
+
+    dense = {name for name, c in columns.items() if c.rows is None or len(c.rows) == n}
+    sparse = {name: c for name, c in columns.items() if name not in dense}
+
+    def value(column: wire.Column, row: int) -> Any:
+        values = column.values
+        return values.unique[values.codes[row]] if isinstance(values, wire.Texts) else values[row].item()
+
+    first = {name: 0 if c.rows is None else int(c.rows[0]) for name, c in columns.items()}
+    rows = sorted(set(first.values()))
+    if len(rows) > MAX_FIRST_ROWS:
+        return None
+    checked = np.array([*rows, n - 1])
+    where, by_rows = {}, {}  # sparse column -> (index of each checked row in its rows, or -1)
+    for name, c in sparse.items():
+        if id(c.rows) not in by_rows:  # the subfields of one repeated entry share their rows
+            at = np.minimum(np.searchsorted(c.rows, checked), len(c.rows) - 1)
+            by_rows[id(c.rows)] = np.where(c.rows[at] == checked, at, -1).tolist()
+        where[name] = by_rows[id(c.rows)]
+    order: dict[str, None] = {}
+    for i, row in enumerate(checked.tolist()):
+        expected: dict[str, Any] = {}
+        flatten(cls.FromString(buf[starts[row]:ends[row]].tobytes()), "", expected)
+        at = {name: w[i] for name, w in where.items() if w[i] >= 0}
+        if len(expected) != len(dense) + len(at) or not all(
+                (k in dense or k in at) and _same(value(columns[k], at.get(k, row)), v) for k, v in expected.items()):
+            return None
+        order.update(dict.fromkeys(expected))
+    if len(order) != len(columns):
+        return None
+    return _frame(times, {name: _values(columns[name], n) for name in order})
+
+
+def _read_topic(f, summary, channel_id: int, decode, arrays: bool = True) -> pd.DataFrame | None:
+    import pandas as pd
+
+    buf, starts, ends, times = _messages(f, summary, channel_id)
+    if not len(starts):
+        return None
+    first = decode(buf[starts[0]:ends[0]].tobytes())
+    if arrays and isinstance(first, Message):
+        frame = _series(first, buf, starts, ends, times)
+        if frame is None and len(starts) >= MIN_COLUMNAR:
+            frame = _columnar(type(first), buf, starts, ends, times)
+        if frame is not None:
+            return frame
+    rows = []
+    for a, b in zip(starts.tolist(), ends.tolist(), strict=True):
+        decoded, row = decode(buf[a:b].tobytes()), {}
+        if isinstance(decoded, dict):
+            row.update(decoded)
+        else:
+            flatten(decoded, "", row)
+        rows.append(row)
+    index = pd.Index(times / 1e9, name="t")
+    return pd.DataFrame.from_records(rows, index=index).sort_index(kind="stable")
 
 
 class _Ros2StringDecoder:
@@ -242,7 +392,7 @@ class _Ros2StringDecoder:
 def read_topics(path: str | Path, topics: Iterable[str], arrays: bool = True) -> dict[str, pd.DataFrame]:
     """Topic -> DataFrame indexed by simulated time `t` (s), for each of `topics` the file has. `arrays=False`
     decodes every message with protobuf (the general path; the benchmark compares the two)."""
-    from mcap.reader import make_reader
+    from mcap.reader import make_reader  # imported where read: a simulate stage never reads MCAP
     from mcap_protobuf.decoder import DecoderFactory
 
     wanted = set(topics)
