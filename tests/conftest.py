@@ -22,3 +22,19 @@ def run_cli(module: str, *args: str, timeout: float = 300) -> subprocess.Complet
 @pytest.fixture
 def data_dir(tmp_path: Path) -> Path:
     return tmp_path / "data"
+
+
+def simulate_case(directory: Path, experiment: str, overrides: list[str] = (), case_id: str | None = None):
+    """One case of `experiment` ("slug/name"; the first case unless `case_id` names one) simulated in this
+    process (no CLI start-up), written to `directory`/<case>.mcap and read back."""
+    from pipeline.core.checks import compose_config
+    from pipeline.core.experiment import resolve
+    from pipeline.core.runlog import RunWriter, read_run
+
+    cases = resolve(experiment).fn(compose_config([f"experiment={experiment}", *overrides]))
+    case = next(c for c in cases if case_id is None or c.id == case_id)
+    path = directory / f"{case.id}.mcap"
+    with RunWriter(path, {"run_id": case.id, "slug": experiment.split("/")[0]}) as w:
+        case.simulate(w)
+        w.close("ok")
+    return read_run(path)

@@ -19,7 +19,7 @@ from pipeline.core import layouts, robot
 from pipeline.core.runlog import RunWriter, read_run
 from pipeline.robotics.urdf import Pose, _euler, _quat_mul, _rotate, describe
 
-from .conftest import ENV
+from .conftest import ENV, simulate_case
 
 # hinge with anchor and ref, slide with ref, ball, free, a geom-less body, a mocap body, capsules: every case
 MODEL = """<mujoco model="demo"><worldbody><geom type="plane" size="1 1 0.1"/>
@@ -215,23 +215,13 @@ PAPER_RUNS = {
 @pytest.fixture(scope="module")
 def paper_runs(tmp_path_factory):
     """Runs are made on demand, one per paper, in this process (no CLI start-up)."""
-    from pipeline.core.checks import compose_config
-    from pipeline.core.experiment import resolve
-
     made: dict[str, object] = {}
 
     def run(key: str):
         if key not in made:
             name, overrides, case_id, _ = PAPER_RUNS[key]
             slug = key.split("/")[0]
-            cfg = compose_config([f"experiment={slug}/{name}", *overrides])
-            cases = resolve(f"{slug}/{name}").fn(cfg)
-            case = next(c for c in cases if case_id is None or c.id == case_id)
-            path = tmp_path_factory.mktemp(slug) / f"{case.id}.mcap"
-            with RunWriter(path, {"run_id": case.id, "slug": slug}) as w:
-                case.simulate(w)
-                w.close("ok")
-            made[key] = read_run(path)
+            made[key] = simulate_case(tmp_path_factory.mktemp(slug), f"{slug}/{name}", overrides, case_id)
         return made[key]
 
     return run
