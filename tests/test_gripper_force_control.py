@@ -24,7 +24,7 @@ from pipeline.papers.gripper_force_control import (
 from pipeline.papers.gripper_force_control.drive import differentiate
 from pipeline.papers.gripper_force_control.lumped import accelerations
 
-from .conftest import ROOT
+from .conftest import ROOT, simulate_case
 
 SYSTEM = OmegaConf.load(ROOT / "conf/system/gripper-force-control.yaml")
 P = gripper(SYSTEM)
@@ -207,3 +207,30 @@ def test_mujoco_mass_matrix_is_the_lumped_one():
     expected = np.array([[P.J_1 * g.k_g ** 2 + P.J_g, cross], [cross, P.J_1 * g.g_f ** 2]])
     expected[1, 1] += SYSTEM.contact.pad_mass * (P.l_f ** 2 + (PAD_THICKNESS / 2) ** 2)   # MuJoCo's pad, not lumped
     assert np.allclose(M[:2, :2], expected, rtol=1e-3, atol=3e-6)   # atol: the 15 g object about the axis
+
+
+def test_lumped_runs_draw_the_mujoco_gripper_in_their_state(tmp_path):
+    """A lumped run draws the MuJoCo plant's gripper (the same URDF as the MuJoCo run of its case) moved by
+    the lumped coordinates: the hinges at the logged φ_g and φ_f, the pad compressed by l_f·φ_f so that it
+    lies on the object's surface whenever the lumped pad presses."""
+    mujoco = pytest.importorskip("mujoco")
+    from pipeline.core.robot import URDF_ATTACHMENT
+
+    lumped, simulated = (simulate_case(tmp_path, "gripper-force-control/force-sag", ["scenario.forms=[]"],
+                                       f"no-feedforward-{plant}") for plant in ("lumped", "mujoco"))
+    assert lumped.attachments[URDF_ATTACHMENT] == simulated.attachments[URDF_ATTACHMENT]
+    drawn, logged = lumped["/joint_states"], lumped["/joint_state"]
+    for joint in ("gripper", "finger"):
+        assert np.allclose(drawn[f"joints.{joint}.position"],
+                           np.interp(drawn.index, logged.index, logged[f"position.{joint}"]), atol=1e-12)
+    model = mujoco.MjModel.from_xml_string(lumped.attachments["model.xml"].decode())
+    data = mujoco.MjData(model)
+    force = np.interp(drawn.index, lumped["/wrench"].index, lumped["/wrench"]["force_x.grasp"])
+    assert (force > 4.0).all()   # held at about F_set = 5 N throughout
+    for k, t in enumerate(drawn.index):
+        for joint in ("gripper", "finger", "pad"):
+            data.qpos[model.joint(joint).qposadr[0]] = drawn.loc[t, f"joints.{joint}.position"]
+        assert data.qpos[model.joint("pad").qposadr[0]] == pytest.approx(P.l_f * drawn.loc[t, "joints.finger.position"])
+        mujoco.mj_kinematics(model, data)
+        gap = mujoco.mj_geomDistance(model, data, model.geom("pad").id, model.geom("object").id, 1.0, None)
+        assert abs(gap) < 1e-5, (k, gap)   # m: touching, up to the pad face's tilt with the finger

@@ -51,32 +51,43 @@ GraspSample = schemas.define(
 
 def run_plant(log: RunWriter, cfg: DictConfig, p: Gripper, s: Schedule, start: Start, plant: str,
               open_stop: float | None = None) -> None:
-    """Simulate one run on `plant` and log it (and, for MuJoCo, the generated model and the body poses).
-    `open_stop`: MuJoCo's finger stops there when opening (the lumped plant has no stops)."""
-    log_every = max(1, round(cfg.log_dt / p.dt))
-    if plant == "mujoco":
-        sim = MujocoGripper(p, cfg.system.contact, open_stop)
-        log.attach("model.xml", sim.xml, "application/xml")
-        tf_every = max(1, round(cfg.tf_dt / p.dt))
-        trace, poses = sim.simulate(s, start, log_every, settle=cfg.mujoco.settle, tf_every=tf_every)
-        log.log_transforms(s.t[::tf_every], "world", list(FRAMES), poses)
-        log.log_robot(s.t[::tf_every], np.array(sim.states))
-        t_tf = s.t[::tf_every]
-        force = np.interp(t_tf, trace.t, trace["force"])  # the grasp force, along the pad's x (/wrench frame)
-        error = np.interp(t_tf, s.t, s.force) - force     # F_set − F: red, from the force arrow's tip
-        keep = robot.thinned(t_tf)
-        for t_k, f_k, e_k in zip(t_tf[keep], force[keep], error[keep], strict=True):
-            log.write("/markers", seconds_to_ns(t_k), schemas.SceneUpdate(entities=[
-                markers.arrow("grasp_force", "pad", [f_k, 0.0, 0.0], FORCE_RGBA, scale=FORCE_SCALE),
-                markers.contacts("force_error", [[FORCE_SCALE * f_k, 0.0, 0.0]], [[e_k, 0.0, 0.0]], FORCE_SCALE,
-                                 frame="pad", diameter=0.002)]))
-    elif plant == "lumped":
-        trace = lumped.simulate(p, s, start, log_every)
-    else:
+    """Simulate one run on `plant` and log it, with the generated MuJoCo model drawn: the plant itself, or
+    the lumped plant's state shown on it (MujocoGripper.configuration says which coordinate drives which
+    joint). `open_stop`: MuJoCo's finger stops there when opening (the lumped plant has no stops)."""
+    if plant not in PLANTS:
         raise ValueError(f"plant={plant!r}: one of {PLANTS}")
+    log_every, tf_every = max(1, round(cfg.log_dt / p.dt)), max(1, round(cfg.tf_dt / p.dt))
+    sim = MujocoGripper(p, cfg.system.contact, open_stop if plant == "mujoco" else None)
+    log.attach("model.xml", sim.xml, "application/xml")
+    t_tf = s.t[::tf_every]
+    if plant == "mujoco":
+        trace, poses = sim.simulate(s, start, log_every, settle=cfg.mujoco.settle, tf_every=tf_every)
+        states = np.array(sim.states)
+    else:
+        trace = lumped.simulate(p, s, start, log_every)
+        # drawn: φ_g (rad) turns hinge `gripper`, φ_f (rad) hinge `finger`, δ = l_f·φ_f ≥ 0 (m) slides `pad`
+        states, poses = sim.drawn(*(np.interp(t_tf, trace.t, trace[x]) for x in ("phi_g", "phi_f")))
     if not np.isfinite(trace["force"]).all():
         raise SimulationFailed("grasp force not finite")
+    draw_grasp(log, sim, s, trace, t_tf, states, poses)
     log_trace(log, p, s, trace, log_every)
+
+
+def draw_grasp(log: RunWriter, sim: MujocoGripper, s: Schedule, trace: Trace, t_tf: np.ndarray,
+               states: np.ndarray, poses: np.ndarray) -> None:
+    """The gripper at times `t_tf` (s): its bodies on `/tf`, its robot (qpos `states` of `sim`'s model), and
+    on `/markers` the grasp force as an arrow on the pad with the force error F_set − F in red from the
+    arrow's tip."""
+    log.log_transforms(t_tf, "world", list(FRAMES), poses)
+    log.log_robot(t_tf, states, model=sim.model)
+    force = np.interp(t_tf, trace.t, trace["force"])  # along the pad's x (/wrench frame)
+    error = np.interp(t_tf, s.t, s.force) - force
+    keep = robot.thinned(t_tf)
+    for t_k, f_k, e_k in zip(t_tf[keep], force[keep], error[keep], strict=True):
+        log.write("/markers", seconds_to_ns(t_k), schemas.SceneUpdate(entities=[
+            markers.arrow("grasp_force", "pad", [f_k, 0.0, 0.0], FORCE_RGBA, scale=FORCE_SCALE),
+            markers.contacts("force_error", [[FORCE_SCALE * f_k, 0.0, 0.0]], [[e_k, 0.0, 0.0]], FORCE_SCALE,
+                             frame="pad", diameter=0.002)]))
 
 
 def log_trace(log: RunWriter, p: Gripper, s: Schedule, trace: Trace, log_every: int) -> None:

@@ -149,18 +149,40 @@ class MujocoGripper:
         self.pad_geom = self.model.geom("pad").id
         self.bodies = [self.model.body(b).id for b in FRAMES]
 
+    def configuration(self, phi_g: float | np.ndarray, phi_f: float | np.ndarray) -> np.ndarray:
+        """qpos (..., nq) of the lumped plant's coordinates (gear constraints hold by construction):
+        joint `gripper` (hinge about z, rad) = φ_g, the gripper's turn; joint `finger` (hinge about y, rad) =
+        φ_f, the Finger's-gear angle, 0 where the unloaded pad touches the object; joint `pad` (slide along
+        x, m) = the pad's compression δ = l_f φ_f while it presses (lumped.contact_force), else 0. The motors
+        are tendons of these: φ_1 = k_g φ_g + g_f φ_f, φ_2 = −g_c φ_g."""
+        phi_g, phi_f = np.broadcast_arrays(np.asarray(phi_g, dtype=float), np.asarray(phi_f, dtype=float))
+        qpos = np.zeros((*phi_g.shape, self.model.nq))
+        qpos[..., self.qpos["gripper"]] = phi_g
+        qpos[..., self.qpos["finger"]] = phi_f
+        qpos[..., self.qpos["pad"]] = np.maximum(self.p.l_f * phi_f, 0.0)
+        return qpos
+
     def place(self, start: Start) -> None:
         """Put the mechanism at rest in the configuration of `start`, gear constraints satisfied."""
         import mujoco
 
         d = self.data
         mujoco.mj_resetData(self.model, d)
-        compression = max(self.p.l_f * float(start.phi_f), 0.0)
-        phi_f = float(start.phi_f)
-        d.qpos[self.qpos["gripper"]] = start.phi_g
-        d.qpos[self.qpos["finger"]] = phi_f
-        d.qpos[self.qpos["pad"]] = compression
+        d.qpos[:] = self.configuration(start.phi_g, start.phi_f)
         mujoco.mj_forward(self.model, d)
+
+    def drawn(self, phi_g: np.ndarray, phi_f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The lumped plant's states (K,) drawn on this model: qpos (K, nq) and the (K, len(FRAMES), 4, 4)
+        world poses of its bodies, by MuJoCo's kinematics."""
+        import mujoco
+
+        qpos = self.configuration(phi_g, phi_f)
+        poses = np.empty((len(qpos), len(self.bodies), 4, 4))
+        for k, q in enumerate(qpos):
+            self.data.qpos[:] = q
+            mujoco.mj_kinematics(self.model, self.data)
+            poses[k] = self.poses()
+        return qpos, poses
 
     def grasp_force(self) -> float:
         """Normal force of the pad-object contact (0 when they do not touch)."""
