@@ -4,6 +4,7 @@ roll invariance of Thm 4.1, the warm start, and the reference values of the Sec.
 
 from __future__ import annotations
 
+import io
 import math
 
 import numpy as np
@@ -26,6 +27,8 @@ from pipeline.papers.curve_discretization import (
 )
 from pipeline.papers.curve_discretization import algorithm as dc
 from pipeline.papers.curve_discretization import snake as sn
+
+from .conftest import simulate_case
 
 CONTROL_POINTS = np.array([[4, 4, 0], [4, -4, 0], [-4, -4, 0], [-4, 4, 0], [0, 0, 4], [4, -4, 6], [4, 4, 8]], float)
 CURVE = bezier(CONTROL_POINTS)
@@ -111,9 +114,8 @@ def test_three_forward_kinematics_put_every_joint_on_the_curve(theta_x0):
                            atol=1e-10)
     mujoco = pytest.importorskip("mujoco")
     assert mujoco
-    body = sn.SnakeBody(radius=0.1, segment_mass=1.0, armature=0.0, damping=0.0, torque_limit=1.0, friction=1.0)
-    xml = sn.snake_mjcf(FIG2, body, timestep=1e-3, kp=1.0, kv=0.0)
-    frames, points = sn.segment_frames(xml, sn.configuration(search.points, angles.R_w1, angles.theta), FIG2)
+    frames, points = sn.segment_frames(sn.chain_mjcf(FIG2), sn.configuration(search.points, angles.R_w1, angles.theta),
+                                       FIG2)   # the model a Fig. 2 run draws
     assert np.abs(points[0] - search.points).max() < 1e-10
     assert np.abs(frames[0] - sequential[::2][:FIG2.segments]).max() < 1e-10
 
@@ -132,6 +134,32 @@ def test_closed_form_screws_eq13_eq14_and_the_eq3_misprint():
     printed = poe_forward_kinematics(search.points[0], angles.theta_z0, angles.theta_y0, math.pi / 4, angles.theta,
                                      FIG2, printed_twist_hat=True)
     assert np.abs(printed[:, :3, 3] - joint_positions(search.points, FIG2.joints)).max() > 1.0
+
+
+def test_fig2_run_draws_the_chain_where_its_tf_puts_the_joints(tmp_path):
+    """A Fig. 2 run carries the chain as a robot (the URDF of the same Chain's MuJoCo model). Moved by the run's
+    /joint_states, link segment i + 1 is the run's /tf frame joint(2i + 1), position and orientation, and every
+    joint m sits on the chain: P_2i = P_2i+1 = Q_i at segment i + 1's origin, P_N at the last segment's end."""
+    yourdfpy = pytest.importorskip("yourdfpy")
+    from scipy.spatial.transform import Rotation
+
+    run = simulate_case(tmp_path, "curve-discretization/bezier-fig2", ["scenario.roll_variants=[]"], "paper")
+    urdf = yourdfpy.URDF.load(io.StringIO(run["/robot_description"]["data"].iloc[0]), load_meshes=False,
+                              load_collision_meshes=False)
+    [state] = run["/joint_states"].filter(like=".position").to_dict("records")
+    urdf.update_cfg({k.removeprefix("joints.").removesuffix(".position"): v for k, v in state.items()})
+    [tf] = run["/tf"].to_dict("records")
+    end = np.eye(4)
+    end[0, 3] = FIG2.segment_lengths[-1]
+    for m in range(1, FIG2.joints + 1):
+        i = m // 2   # P_m = Q_i
+        link = urdf.get_transform(f"{urdf.robot.name}/segment{min(i, FIG2.segments - 1) + 1}", "world")
+        drawn = link if i < FIG2.segments else link @ end
+        frame = f"transforms.joint{m}"
+        assert np.allclose(drawn[:3, 3], [tf[f"{frame}.translation.{a}"] for a in "xyz"], atol=1e-9), m
+        if m % 2:
+            logged = Rotation.from_quat([tf[f"{frame}.rotation.{a}"] for a in "xyzw"]).as_matrix()
+            assert np.allclose(drawn[:3, :3], logged, atol=1e-9), m
 
 
 def test_roll_invariance_thm41():

@@ -51,13 +51,6 @@ def _solve(curve: dc.Curve, chain: dc.Chain, theta_x0: float, cfg: DictConfig) -
 # -- E1: Fig. 2, the 30-joint Bézier example --------------------------------------------------------------
 
 
-def mujoco_points(chain: dc.Chain, search: dc.Search, angles: dc.Angles) -> np.ndarray:
-    """The chain's joint points by MuJoCo's kinematics of the snake model at the solved angles."""
-    body = sn.SnakeBody(radius=0.1, segment_mass=1.0, armature=0.0, damping=0.0, torque_limit=1.0, friction=1.0)
-    xml = sn.snake_mjcf(chain, body, timestep=1e-3, kp=1.0, kv=0.0)  # only the geometry matters here
-    return sn.segment_frames(xml, sn.configuration(search.points, angles.R_w1, angles.theta), chain)[1][0]
-
-
 def bezier_fig2(cfg: DictConfig) -> list[Case]:
     curve = paper_curve(cfg)
     chain = dc.Chain.uniform(cfg.system.chain.joints, cfg.system.chain.link_length)
@@ -65,9 +58,12 @@ def bezier_fig2(cfg: DictConfig) -> list[Case]:
     if cfg.system.twist_hat not in ("corrected", "printed"):
         raise ValueError(f"system.twist_hat={cfg.system.twist_hat!r} must be corrected or printed")
     printed = cfg.system.twist_hat == "printed"
+    xml = sn.chain_mjcf(chain)
 
     def simulate(log: RunWriter, theta_x0: float) -> None:
+        log.attach(MODEL_ATTACHMENT, xml, "application/xml")
         search, angles = _solve(curve, chain, theta_x0, cfg)
+        qpos = sn.configuration(search.points, angles.R_w1, angles.theta)
         P = dc.joint_positions(search.points, chain.joints)
         samples = np.linspace(curve.t_start, curve.t_end, cfg.scenario.curve_samples)
         _log_points(log, "/curve", curve(samples), parameter=samples)
@@ -77,12 +73,15 @@ def bezier_fig2(cfg: DictConfig) -> list[Case]:
         poe = dc.poe_forward_kinematics(search.points[0], angles.theta_z0, angles.theta_y0, theta_x0, angles.theta,
                                         chain, printed)
         _log_points(log, "/chain/poe", poe[:, :3, 3], names)
-        _log_points(log, "/chain/mujoco", dc.joint_positions(mujoco_points(chain, search, angles), chain.joints), names)
+        # the chain's joint points by MuJoCo's kinematics of the model drawn, at the solved angles
+        _log_points(log, "/chain/mujoco", dc.joint_positions(sn.segment_frames(xml, qpos, chain)[1][0], chain.joints),
+                    names)
         log.log("/joint_state", 0.0, units="rad", name=names, position=angles.theta.tolist())
         log.log("/chain/first_frame", 0.0, schemas.Scalars, units=["rad", "rad", "rad", "1"],
                 name=["theta_z0", "theta_y0", "theta_x0", "evaluations"],
                 value=[angles.theta_z0, angles.theta_y0, theta_x0, search.evaluations])
         log.log_transforms(np.zeros(1), "world", names, frames[None])
+        log.log_robot(np.zeros(1), qpos[None])   # drawn: link segment{i + 1} in /tf frame joint{2i + 1}
 
     rolls = [("paper", cfg.system.theta_x0)] + [(f"roll-{r:g}", r) for r in cfg.scenario.roll_variants]
     return [Case(name, lambda log, r=roll: simulate(log, r)) for name, roll in rolls]

@@ -21,6 +21,7 @@ from pipeline.papers.curve_discretization.algorithm import Chain, Curve, joint_a
 from pipeline.robotics.transforms import quaternion_wxyz
 
 WARMUP_CALLS = 20  # untimed calls of the algorithm before the control loop
+CHAIN_RADIUS = 0.08  # of the segment length: a drawn chain's capsules (Fig. 2 draws the chain as a line)
 
 
 @dataclass(frozen=True)
@@ -45,9 +46,9 @@ def point_names(chain: Chain) -> list[str]:
     return ["joint1", *(f"joint{2 * i}" for i in range(1, chain.segments + 1))]
 
 
-def snake_mjcf(chain: Chain, body: SnakeBody, *, timestep: float, kp: float, kv: float) -> str:
-    """MJCF of the snake on a floor, driven per hinge by kp·(q_ref − q) + kv·(q̇_ref − q̇), clamped to the torque
-    limit. Controls: [q_ref (J), q̇_ref (J)] in the order of `joint_names`."""
+def snake_mjcf(chain: Chain, body: SnakeBody, *, timestep: float, kp: float, kv: float, floor: bool = True) -> str:
+    """MJCF of the snake on a floor (or in the air), driven per hinge by kp·(q_ref − q) + kv·(q̇_ref − q̇),
+    clamped to the torque limit. Controls: [q_ref (J), q̇_ref (J)] in the order of `joint_names`."""
     lengths = chain.segment_lengths
     names = joint_names(chain)
     parts: list[str] = []
@@ -64,6 +65,9 @@ def snake_mjcf(chain: Chain, body: SnakeBody, *, timestep: float, kp: float, kv:
     closing = [f'{"    " * (i + 2)}</body>' for i in reversed(range(len(lengths)))]
     actuators = [f'    <position joint="{j}" kp="{kp:.17g}"/>' for j in names]
     actuators += [f'    <velocity joint="{j}" kv="{kv:.17g}"/>' for j in names]
+    ground = """    <light pos="0 0 4" dir="0 0 -1"/>
+    <geom name="floor" type="plane" size="0 0 0.1" contype="0" conaffinity="1" rgba="0.8 0.8 0.8 1"/>
+""" if floor else ""
     return f"""<mujoco model="snake_{chain.joints}_joints">
   <compiler angle="radian" autolimits="true"/>
   <option timestep="{timestep:.17g}" integrator="implicitfast"/>
@@ -74,9 +78,7 @@ def snake_mjcf(chain: Chain, body: SnakeBody, *, timestep: float, kp: float, kv:
           friction="{body.friction:.17g} 0.005 0.0001" rgba="0.35 0.55 0.3 1"/>
   </default>
   <worldbody>
-    <light pos="0 0 4" dir="0 0 -1"/>
-    <geom name="floor" type="plane" size="0 0 0.1" contype="0" conaffinity="1" rgba="0.8 0.8 0.8 1"/>
-{chr(10).join(parts)}
+{ground}{chr(10).join(parts)}
 {chr(10).join(closing)}
   </worldbody>
   <actuator>
@@ -84,6 +86,15 @@ def snake_mjcf(chain: Chain, body: SnakeBody, *, timestep: float, kp: float, kv:
   </actuator>
 </mujoco>
 """
+
+
+def chain_mjcf(chain: Chain) -> str:
+    """The chain alone, as the snake's body in the air (no floor, no physics of interest): what the Fig. 2
+    runs check their kinematics on and draw. Segment i + 1's frame is the paper's frame 2i + 1 (θ_1 = 0), its
+    origin Q_i; the capsules' radius is a drawing choice, CHAIN_RADIUS of the shortest segment."""
+    body = SnakeBody(radius=CHAIN_RADIUS * float(chain.segment_lengths.min()), segment_mass=1.0, armature=0.0,
+                     damping=0.0, torque_limit=1.0, friction=1.0)
+    return snake_mjcf(chain, body, timestep=1e-3, kp=1.0, kv=0.0, floor=False)
 
 
 def configuration(points: np.ndarray, R_w1: np.ndarray, theta: np.ndarray, offset=(0.0, 0.0, 0.0)) -> np.ndarray:
