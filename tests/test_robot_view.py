@@ -188,7 +188,10 @@ def test_view_writes_under_data_views(tmp_path):
 PAPER_RUNS = {
     "ur5-ik-fsm": ("singular-paths", ["scenario.paths=[wrist]", "scenario.duration=0.5"], "wrist-near-alg1", False),
     "curve-discretization": ("snake-gait", ["scenario.duration=0.2", "scenario.joints=6"], "lateral-undulation", False),
+    "curve-discretization/bezier-fig2": ("bezier-fig2", [], "paper", False),
     "gripper-force-control": ("pick-and-place", [], None, False),
+    "gripper-force-control/lumped": ("force-sag", ["scenario.plants=[lumped]", "scenario.forms=[]"],
+                                     "no-feedforward-lumped", True),
     "partial-lagrangian": ("two-link", ["scenario.pd.duration=0.3"], "pd", False),
     "cobot-6r-ik": ("trajectory", ["scenario.duration=0.2"], "line", False),
     "nmpc-cdkd": ("tracking", ["scenario.duration=0.6", "scenario.t0=0.1", "scenario.t1=0.5"], None, False),
