@@ -10,7 +10,7 @@ import math
 import numpy as np
 from omegaconf import DictConfig
 
-from pipeline.core import schemas
+from pipeline.core import markers, schemas
 from pipeline.core.experiment import Case
 from pipeline.core.runlog import MODEL_ATTACHMENT, RunWriter, SimulationFailed
 from pipeline.core.timing import log_timings, time_interleaved
@@ -50,6 +50,8 @@ def _solve(curve: dc.Curve, chain: dc.Chain, theta_x0: float, cfg: DictConfig) -
 
 # -- E1: Fig. 2, the 30-joint Bézier example --------------------------------------------------------------
 
+CURVE_RGBA = (0.85, 0.15, 0.1, 1.0)
+
 
 def bezier_fig2(cfg: DictConfig) -> list[Case]:
     curve = paper_curve(cfg)
@@ -66,7 +68,11 @@ def bezier_fig2(cfg: DictConfig) -> list[Case]:
         qpos = sn.configuration(search.points, angles.R_w1, angles.theta)
         P = dc.joint_positions(search.points, chain.joints)
         samples = np.linspace(curve.t_start, curve.t_end, cfg.scenario.curve_samples)
-        _log_points(log, "/curve", curve(samples), parameter=samples)
+        on_curve = curve(samples)
+        _log_points(log, "/curve", on_curve, parameter=samples)
+        log.write("/markers", 0, schemas.SceneUpdate(entities=[   # Fig. 2's curve beside the chain drawn
+            markers.line_strip("curve", on_curve, thickness=0.3 * sn.CHAIN_RADIUS * chain.segment_lengths.min(),
+                               color=CURVE_RGBA)]))
         _log_points(log, "/chain/curve", P, names, dc.joint_positions(search.t[:, None], chain.joints)[:, 0])
         frames = dc.forward_kinematics(search.points[0], angles.R_w1, angles.theta, chain)
         _log_points(log, "/chain/fk", frames[:, :3, 3], names)
