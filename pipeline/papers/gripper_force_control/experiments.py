@@ -69,17 +69,17 @@ def run_plant(log: RunWriter, cfg: DictConfig, p: Gripper, s: Schedule, start: S
         states, poses = sim.drawn(*(np.interp(t_tf, trace.t, trace[x]) for x in ("phi_g", "phi_f")))
     if not np.isfinite(trace["force"]).all():
         raise SimulationFailed("grasp force not finite")
-    draw_grasp(log, sim, s, trace, t_tf, states, poses)
+    draw_grasp(log, s, trace, t_tf, states, poses)
     log_trace(log, p, s, trace, log_every)
 
 
-def draw_grasp(log: RunWriter, sim: MujocoGripper, s: Schedule, trace: Trace, t_tf: np.ndarray,
-               states: np.ndarray, poses: np.ndarray) -> None:
-    """The gripper at times `t_tf` (s): its bodies on `/tf`, its robot (qpos `states` of `sim`'s model), and
-    on `/markers` the grasp force as an arrow on the pad with the force error F_set − F in red from the
+def draw_grasp(log: RunWriter, s: Schedule, trace: Trace, t_tf: np.ndarray, states: np.ndarray,
+               poses: np.ndarray) -> None:
+    """The gripper at times `t_tf` (s): its bodies on `/tf`, its robot (qpos `states` of the attached model),
+    and on `/markers` the grasp force as an arrow on the pad with the force error F_set − F in red from the
     arrow's tip."""
     log.log_transforms(t_tf, "world", list(FRAMES), poses)
-    log.log_robot(t_tf, states, model=sim.model)
+    log.log_robot(t_tf, states)
     force = np.interp(t_tf, trace.t, trace["force"])  # along the pad's x (/wrench frame)
     error = np.interp(t_tf, s.t, s.force) - force
     keep = robot.thinned(t_tf)
