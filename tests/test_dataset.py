@@ -10,6 +10,7 @@ import pandas as pd
 import pytest
 import yaml
 
+from analysis.core import report
 from pipeline.core import stages
 from pipeline.core.checks import BadInput, preflight
 from pipeline.core.runlog import RunWriter, read_run, read_runs, run_files
@@ -47,6 +48,11 @@ def test_an_experiment_exports_to_a_lerobot_dataset_with_units_and_a_card(data_d
 
     frames, episodes = _load(root)
     assert frames.num_rows == info["total_frames"] == sum(episodes["length"])
+    # the report's index lists it, with its card
+    (listed,) = report.dataset_rows(data_dir, data_dir / "report")
+    assert listed["name"] == "ur5-ik-fsm/singular-paths"
+    assert listed["card"] == "../datasets/ur5-ik-fsm/singular-paths/README.md"
+    assert (listed["episodes"], listed["frames"], listed["fps"]) == (4, info["total_frames"], 100)
     assert episodes["dataset_from_index"][1:] == episodes["dataset_to_index"][:-1]
     assert frames.features["observation.state"].length == 12
     table = frames.to_pandas()

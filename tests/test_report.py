@@ -356,9 +356,16 @@ def test_cells_with_pipes_and_markup_cannot_break_a_page(tmp_path):
     assert_tables_whole(html, "paper.html (bands)")
     markdown_rows_whole(report.render("paper.md.j2", **context), "paper.md (bands)")
     assert not report.undeclared_bands(info, banded) and report.undeclared_bands({**info, "bands": []}, banded)
-    index = report.index_context([(info, evaluated, runs)])
-    assert_tables_whole(report.render("index.html.j2", **index), "index.html")
-    markdown_rows_whole(report.render("index.md.j2", **index), "index.md")
+    for datasets in ([], [{"name": "ur5-ik-fsm/random-paths", "card": "../datasets/ur5-ik-fsm/random-paths/README.md",
+                           "format": "LeRobot v3.0", "episodes": 2, "frames": 10, "fps": 5, "size_mb": 0.1},
+                          {"name": "gripper-review", "card": "../datasets/gripper-review/README.md",
+                           "format": "tables (Parquet, CSV)", "episodes": None, "frames": None, "fps": None,
+                           "size_mb": 0.2}]):
+        index = report.index_context([(info, evaluated, runs)], datasets)
+        html = report.render("index.html.j2", **index)
+        assert_tables_whole(html, "index.html")
+        markdown_rows_whole(report.render("index.md.j2", **index), "index.md")
+        assert all(f'href="{d["card"]}"' in html for d in datasets)
 
 
 # -- a full report (after `python -m dvc repro`) --------------------------------------------------------------------

@@ -327,7 +327,24 @@ def _paper_row(info: dict, evaluated: pd.DataFrame, runs: pd.DataFrame) -> dict:
             "runs": len(runs), "failed": int((~runs["ok"].astype(bool)).sum()) if not runs.empty else 0}
 
 
-def index_context(papers: list[tuple[dict, pd.DataFrame, pd.DataFrame]]) -> dict:
+def dataset_rows(data_dir: Path, report_dir: Path) -> list[dict]:
+    """Every dataset under `data_dir/datasets` with its card: the LeRobot exports (`<slug>/<experiment>/`, sizes
+    from meta/info.json) and the curated tables (`<slug>/`)."""
+    rows = []
+    root = data_dir / "datasets"
+    for card in sorted([*root.glob("*/README.md"), *root.glob("*/*/README.md")]):
+        folder = card.parent
+        info_path = folder / "meta" / "info.json"
+        info = json.loads(info_path.read_text()) if info_path.is_file() else {}
+        size = sum(f.stat().st_size for f in folder.rglob("*") if f.is_file())
+        rows.append({"name": folder.relative_to(root).as_posix(), "card": os.path.relpath(card, report_dir),
+                     "format": f"LeRobot {info['codebase_version']}" if info else "tables (Parquet, CSV)",
+                     "episodes": info.get("total_episodes"), "frames": info.get("total_frames"),
+                     "fps": info.get("fps"), "size_mb": size / 1e6})
+    return rows
+
+
+def index_context(papers: list[tuple[dict, pd.DataFrame, pd.DataFrame]], datasets: list[dict]) -> dict:
     rows = [_paper_row(*p) for p in papers]
     total = {"cells": {k: [] for k in CATEGORIES}, "open": sum(r["open"] for r in rows),
              "misses": sum(r["misses"] for r in rows), "runs": sum(r["runs"] for r in rows),
@@ -342,6 +359,7 @@ def index_context(papers: list[tuple[dict, pd.DataFrame, pd.DataFrame]]) -> dict
         n.update(dict(r["consistency"]))
     total["consistency"] = [(s, n[s]) for s in SELF_STATUSES if n[s]]
     return {"title": "Reproduction report", "papers": rows, "total": total, "categories": CATEGORIES,
+            "datasets": datasets,
             "status_meaning": STATUS_MEANING, "machine": provenance.machine(), "revision": provenance.git_revision()}
 
 

@@ -114,7 +114,8 @@ def write_report(data_dir: Path) -> tuple[Path, list[str]]:
         all_evaluated.append(evaluated)
         problems += report.undeclared_bands(info, evaluated) + self_check(evaluated)
     report.write_summary(report.write_targets_csv(all_evaluated, report_dir / "targets.csv"), data_dir / "summary")
-    return report.write_index(report_dir, report.index_context(pages)), problems
+    context = report.index_context(pages, report.dataset_rows(data_dir, report_dir))
+    return report.write_index(report_dir, context), problems
 
 
 def _analyze_or_say_why(experiment_id: str, data_dir: Path) -> tuple[Path | None, str | None]:
