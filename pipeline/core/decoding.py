@@ -17,7 +17,7 @@ left out is no column.
 from __future__ import annotations
 
 import functools
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -389,6 +389,9 @@ class _Ros2StringDecoder:
         return None
 
 
+_DECODERS: dict[tuple, Callable[[bytes], Any]] = {}   # (message encoding, schema name, encoding, data) -> decode
+
+
 def read_topics(path: str | Path, topics: Iterable[str], arrays: bool = True) -> dict[str, pd.DataFrame]:
     """Topic -> DataFrame indexed by simulated time `t` (s), for each of `topics` the file has. `arrays=False`
     decodes every message with protobuf (the general path; the benchmark compares the two)."""
@@ -397,7 +400,6 @@ def read_topics(path: str | Path, topics: Iterable[str], arrays: bool = True) ->
 
     wanted = set(topics)
     frames: dict[str, pd.DataFrame] = {}
-    factories = (DecoderFactory(), _Ros2StringDecoder())
     with open(path, "rb") as f:
         summary = make_reader(f).get_summary()
         if summary is None:
@@ -406,7 +408,12 @@ def read_topics(path: str | Path, topics: Iterable[str], arrays: bool = True) ->
             if channel.topic not in wanted:
                 continue
             schema = summary.schemas[channel.schema_id]
-            decode = next(d for d in (f.decoder_for(channel.message_encoding, schema) for f in factories) if d)
+            key = (channel.message_encoding, schema.name, schema.encoding, schema.data)
+            if key not in _DECODERS:  # a schema's message classes are built once per process, not once per file
+                factories = (DecoderFactory(), _Ros2StringDecoder())
+                _DECODERS[key] = next(d for d in (f.decoder_for(channel.message_encoding, schema)
+                                                  for f in factories) if d)
+            decode = _DECODERS[key]
             frame = _read_topic(f, summary, channel_id, decode, arrays)
             if frame is not None:
                 frames[channel.topic] = frame
