@@ -45,6 +45,16 @@ def driven(radii, seed: int, steps: int = 60) -> RollingChain:
     return plant
 
 
+def assert_drawn_where_plant_and_model_put_it(urdf, description, qpos, plant, radii) -> None:
+    """The URDF at the hinge angles puts every sphere where the exact plant and the paper's model (eqs. 17, 26)
+    put it, positions and rotations within 1e-12."""
+    pos, rot = urdf_frames(urdf, description, qpos, len(radii) - 1)
+    plant_pos, plant_rot = plant.frames()
+    model_pos, model_rot = Chain(radii, q1=plant.model_state()[0], q2=plant.model_state()[1]).frames()
+    assert np.abs(pos - plant_pos).max() < 1e-12 and np.abs(rot - plant_rot).max() < 1e-12
+    assert np.abs(pos - model_pos).max() < 1e-12 and np.abs(rot - model_rot).max() < 1e-12
+
+
 @pytest.mark.parametrize("n", [3, 4])
 def test_urdf_fk_equals_rolling_and_the_papers_fk(n):
     radii = np.full(n + 1, RADIUS)
@@ -54,12 +64,8 @@ def test_urdf_fk_equals_rolling_and_the_papers_fk(n):
     for seed in range(6):
         plant = driven(radii, seed)
         qpos = hinge_angles(plant.tangent, plant.relative, radii)
-        pos, rot = urdf_frames(urdf, description, qpos, n)
-        plant_pos, plant_rot = plant.frames()
-        model_pos, model_rot = Chain(radii, q1=plant.model_state()[0], q2=plant.model_state()[1]).frames()
-        assert np.abs(pos - plant_pos).max() < 1e-12 and np.abs(rot - plant_rot).max() < 1e-12
-        assert np.abs(pos - model_pos).max() < 1e-12 and np.abs(rot - model_rot).max() < 1e-12
-        assert np.abs(plant_pos[1:] - plant_pos[:1]).max() > 0.05   # the chain did move away from straight up
+        assert_drawn_where_plant_and_model_put_it(urdf, description, qpos, plant, radii)
+        assert np.abs(plant.frames()[0][1:] - plant.frames()[0][:1]).max() > 0.05   # moved away from straight up
         # equal spheres: the roll is halved between the two sides and the azimuths cancel
         azimuth, lower, upper, back = qpos.reshape(n, 4).T
         assert np.allclose(lower, upper, atol=1e-15) and np.allclose(back, -azimuth, atol=1e-15)
@@ -77,11 +83,7 @@ def test_unequal_spheres_share_the_roll_in_the_radius_ratio():
     assert lower == pytest.approx(2.0 * upper, rel=1e-12) and upper > 0.1
     assert abs(lean) < 1e-15 and back == pytest.approx(-azimuth, abs=1e-12)
     urdf, description = urdf_of(radii)
-    pos, rot = urdf_frames(urdf, description, qpos[None], 1)
-    plant_pos, plant_rot = plant.frames()
-    model_pos, model_rot = Chain(radii, q1=plant.model_state()[0], q2=plant.model_state()[1]).frames()
-    assert np.abs(pos - plant_pos).max() < 1e-12 and np.abs(rot - plant_rot).max() < 1e-12
-    assert np.abs(pos - model_pos).max() < 1e-12 and np.abs(rot - model_rot).max() < 1e-12
+    assert_drawn_where_plant_and_model_put_it(urdf, description, qpos[None], plant, radii)
 
 
 @pytest.mark.parametrize("radii", [[0.04, 0.03], [0.02, 0.04], [0.04, 0.03, 0.034, 0.05]],
@@ -90,18 +92,13 @@ def test_unequal_spheres_on_any_rolling_path(radii):
     """Unequal spheres driven round random curves (the trolleys steer) end leaning and twisted, off the four-hinge
     form: the five hinges draw them exactly, at every random state, as the plant and the paper's model put them."""
     radii = np.asarray(radii)
-    n = len(radii) - 1
     urdf, description = urdf_of(radii)
     assert urdf.actuated_joint_names == hinge_names(radii) == description.joint_names
     leans = []
     for seed in range(6):
         plant = driven(radii, seed)
         qpos = hinge_angles(plant.tangent, plant.relative, radii)
-        pos, rot = urdf_frames(urdf, description, qpos, n)
-        plant_pos, plant_rot = plant.frames()
-        model_pos, model_rot = Chain(radii, q1=plant.model_state()[0], q2=plant.model_state()[1]).frames()
-        assert np.abs(pos - plant_pos).max() < 1e-12 and np.abs(rot - plant_rot).max() < 1e-12
-        assert np.abs(pos - model_pos).max() < 1e-12 and np.abs(rot - model_rot).max() < 1e-12
+        assert_drawn_where_plant_and_model_put_it(urdf, description, qpos, plant, radii)
         leans.append(np.abs(qpos[[k for k, name in enumerate(hinge_names(radii)) if "lean" in name]]).max())
     assert max(leans) > 0.01   # the states are off the four-hinge form: a lean is needed to draw them
 
