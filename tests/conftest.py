@@ -24,6 +24,16 @@ def data_dir(tmp_path: Path) -> Path:
     return tmp_path / "data"
 
 
+def simulate_experiment(data_dir: Path, experiment: str, overrides: list[str] = (), sweep: list[str] = ()) -> None:
+    """An experiment's runs written under `data_dir` by the simulate stage's own code, in this process (no CLI
+    start-up); `sweep` are a sweep point's overrides, which name its runs as `-m` names them."""
+    from pipeline.core.checks import compose_config
+    from pipeline.core.runner import simulate
+
+    cfg = compose_config([f"experiment={experiment}", f"data_dir={data_dir}", "progress=false", *overrides, *sweep])
+    assert simulate(cfg, experiment, list(sweep)) == 0
+
+
 def simulate_case(directory: Path, experiment: str, overrides: list[str] = (), case_id: str | None = None):
     """One case of `experiment` ("slug/name"; the first case unless `case_id` names one) simulated in this
     process (no CLI start-up), written to `directory`/<case>.mcap and read back."""

@@ -6,9 +6,9 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
-from pipeline.core.checks import compose_config
 from pipeline.core.runlog import read_run
-from pipeline.core.runner import simulate
+
+from .conftest import simulate_experiment
 
 # fewer queries and a coarser spatial grid than the defaults; the run ids stay the defaults' so the targets find them
 SHORT = {
@@ -24,9 +24,7 @@ def data(tmp_path_factory):
 
     data_dir = tmp_path_factory.mktemp("kinematic-graph") / "data"
     for name, overrides in SHORT.items():
-        cfg = compose_config([f"experiment=kinematic-graph/{name}", f"data_dir={data_dir}", "progress=false",
-                              *overrides])
-        assert simulate(cfg, f"kinematic-graph/{name}") == 0
+        simulate_experiment(data_dir, f"kinematic-graph/{name}", overrides)
         assert analyze(f"kinematic-graph/{name}", data_dir) is not None
     write_report(data_dir)
     return data_dir

@@ -8,11 +8,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pipeline.core.checks import BadInput, compose_config, preflight
+from pipeline.core.checks import BadInput, preflight
 from pipeline.core.runlog import read_run, run_files
-from pipeline.core.runner import simulate
 
-from .conftest import run_cli
+from .conftest import run_cli, simulate_experiment
 
 SLUG = "quadruped-irondog"
 SHORT = {  # reduced sizes: the same code paths, a fraction of the time
@@ -25,16 +24,11 @@ SHORT = {  # reduced sizes: the same code paths, a fraction of the time
 }
 
 
-def _simulate(name: str, data_dir, extra: list[str]) -> None:
-    cfg = compose_config([f"experiment={SLUG}/{name}", f"data_dir={data_dir}", "progress=false", *extra])
-    assert simulate(cfg, f"{SLUG}/{name}") == 0
-
-
 @pytest.fixture(scope="module")
 def report(tmp_path_factory):
     data_dir = tmp_path_factory.mktemp("quadruped") / "data"
     for name, extra in SHORT.items():
-        _simulate(name, data_dir, extra)
+        simulate_experiment(data_dir, f"{SLUG}/{name}", extra)
     proc = run_cli("analysis", f"data_dir={data_dir}")
     assert proc.returncode == 0, proc.stderr
     targets = pd.read_csv(data_dir / "report" / "targets.csv")
@@ -91,7 +85,7 @@ def test_run_files_carry_the_robot(report):
 
 def test_runs_are_deterministic(tmp_path):
     for k in (0, 1):
-        _simulate("stand", tmp_path / f"d{k}", ["scenario.duration=0.3", "scenario.payloads=[0]"])
+        simulate_experiment(tmp_path / f"d{k}", f"{SLUG}/stand", ["scenario.duration=0.3", "scenario.payloads=[0]"])
     a, b = (read_run(tmp_path / f"d{k}/runs/{SLUG}/stand/robot.mcap") for k in (0, 1))
     for topic in ("/joint_state", "/wrench", "/tf"):
         pd.testing.assert_frame_equal(a[topic], b[topic])

@@ -59,18 +59,24 @@ def mujoco_poses(model, qpos, mocap_pos, mocap_quat):
     return out
 
 
+def assert_urdf_fk_is_mujocos(urdf: yourdfpy.URDF, description, model, states) -> None:
+    """At each of the (qpos, mocap_pos, mocap_quat) `states`, every body of the URDF moved by the description's
+    joint positions sits where MuJoCo's FK puts it (1e-9)."""
+    qpos, mocap_pos, mocap_quat = states
+    positions = description.joint_positions(qpos, mocap_pos, mocap_quat)
+    for q, (xpos, xmat) in zip(positions, mujoco_poses(model, qpos, mocap_pos, mocap_quat), strict=True):
+        urdf.update_cfg(dict(zip(description.joint_names, q, strict=True)))
+        for b in range(1, model.nbody):
+            T = urdf.get_transform(f"{description.name}/{model.body(b).name}", "world")
+            assert np.allclose(T[:3, 3], xpos[b], atol=1e-9) and np.allclose(T[:3, :3], xmat[b], atol=1e-9)
+
+
 def test_urdf_parses_and_its_fk_is_mujocos():
     model = mujoco.MjModel.from_xml_string(MODEL)
     description = describe(model)
     urdf = yourdfpy.URDF.load(io.StringIO(description.urdf()), load_meshes=False, load_collision_meshes=False)
     assert sorted(urdf.actuated_joint_names) == sorted(description.joint_names)
-    qpos, mocap_pos, mocap_quat = random_states(model, 12)
-    positions = description.joint_positions(qpos, mocap_pos, mocap_quat)
-    for q, (xpos, xmat) in zip(positions, mujoco_poses(model, qpos, mocap_pos, mocap_quat), strict=True):
-        urdf.update_cfg(dict(zip(description.joint_names, q, strict=True)))
-        for b in range(1, model.nbody):
-            T = urdf.get_transform(f"demo/{model.body(b).name}", "world")
-            assert np.allclose(T[:3, 3], xpos[b], atol=1e-9) and np.allclose(T[:3, :3], xmat[b], atol=1e-9)
+    assert_urdf_fk_is_mujocos(urdf, description, model, random_states(model, 12))
 
 
 def test_link_transforms_compose_to_mujocos_poses():
@@ -252,13 +258,7 @@ def test_every_articulated_paper_draws_its_robot(slug, paper_runs):
     model = mujoco.MjModel.from_xml_string(run.attachments["model.xml"].decode())
     description = describe(model)
     assert description.urdf() == run.attachments[robot.URDF_ATTACHMENT].decode()
-    qpos, mocap_pos, mocap_quat = random_states(model, 3, seed=7)
-    positions = description.joint_positions(qpos, mocap_pos, mocap_quat)
-    for q, (xpos, xmat) in zip(positions, mujoco_poses(model, qpos, mocap_pos, mocap_quat), strict=True):
-        urdf.update_cfg(dict(zip(description.joint_names, q, strict=True)))
-        for b in range(1, model.nbody):
-            T = urdf.get_transform(f"{description.name}/{model.body(b).name}", "world")
-            assert np.allclose(T[:3, 3], xpos[b], atol=1e-9) and np.allclose(T[:3, :3], xmat[b], atol=1e-9)
+    assert_urdf_fk_is_mujocos(urdf, description, model, random_states(model, 3, seed=7))
     if PAPER_RUNS[slug][3]:
         states, tf = run["/joint_states"], run["/tf"]
         names = _joint_state_names(run)

@@ -6,9 +6,9 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
-from pipeline.core.checks import compose_config
 from pipeline.core.runlog import read_run
-from pipeline.core.runner import simulate
+
+from .conftest import simulate_experiment
 
 # shorter runs than the defaults; the run ids stay the defaults' so that the targets find them
 SHORT = {
@@ -25,8 +25,7 @@ def data(tmp_path_factory):
 
     data_dir = tmp_path_factory.mktemp("src-joint") / "data"
     for name, overrides in SHORT.items():
-        cfg = compose_config([f"experiment=src-joint/{name}", f"data_dir={data_dir}", "progress=false", *overrides])
-        assert simulate(cfg, f"src-joint/{name}") == 0
+        simulate_experiment(data_dir, f"src-joint/{name}", overrides)
         assert analyze(f"src-joint/{name}", data_dir) is not None
     write_report(data_dir)
     return data_dir

@@ -8,9 +8,9 @@ import pandas as pd
 import pytest
 from scipy.spatial.transform import Rotation
 
-from pipeline.core.checks import compose_config
 from pipeline.core.runlog import read_run
-from pipeline.core.runner import simulate
+
+from .conftest import simulate_experiment
 
 SLUG = "srs-collision-avoidance"
 SHORT = ["system.task.samples=300", "system.task.rides=1.5"]
@@ -28,9 +28,7 @@ def data(tmp_path_factory):
     data_dir = tmp_path_factory.mktemp(SLUG) / "data"
     for name, (fixed, sweep) in RUNS.items():
         for params in sweep:   # sweep runs are named by their overrides, as `-m` names them
-            cfg = compose_config([f"experiment={SLUG}/{name}", f"data_dir={data_dir}", "progress=false", *fixed,
-                                  *params])
-            assert simulate(cfg, f"{SLUG}/{name}", params) == 0
+            simulate_experiment(data_dir, f"{SLUG}/{name}", fixed, params)
         assert analyze(f"{SLUG}/{name}", data_dir) is not None
     write_report(data_dir)
     return data_dir

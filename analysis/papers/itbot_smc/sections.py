@@ -12,6 +12,7 @@ import pandas as pd
 from analysis.core.compute_time import machine_of
 from analysis.core.metrics import metric_value
 from analysis.core.sections import Section, Table
+from analysis.core.targets import paper_value
 from analysis.papers.itbot_smc.analyses import WHERE
 from analysis.papers.itbot_smc.metrics import LAWS
 
@@ -104,7 +105,8 @@ def support_section(frame: pd.DataFrame) -> Section:
                    "carrying the share s of the 11 lb weight and the arm (the controller's model knows it), the band "
                    "of the force targets; `paper-model-<law>`: the controller uses eqs. (A8)-(A10) alone while the "
                    "subject carries all the weight, so only the load's inertia, the drive and its friction are "
-                   "unknown to it (a missing row: the run failed, see Runs). The paper measured Fx ≈ 14 N, Fy ≈ 10 N.",
+                   "unknown to it (a missing row: the run failed, see Runs). The paper measured "
+                   f"Fx ≈ {paper_value('itbot-smc', 'force.fx'):g} N, Fy ≈ {paper_value('itbot-smc', 'force.fy'):g} N.",
                    Table(pd.DataFrame(rows)), category="force errors")
 
 
