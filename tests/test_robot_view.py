@@ -17,7 +17,7 @@ from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
 
 from pipeline.core import layouts, robot
 from pipeline.core.runlog import RunWriter, read_run
-from pipeline.robotics.urdf import Pose, _euler, _quat_mul, _rotate, describe
+from pipeline.robotics.urdf import Pose, _euler, _quat_mul, _rotate, describe, described
 
 from .conftest import ENV, simulate_case
 
@@ -77,6 +77,16 @@ def test_urdf_parses_and_its_fk_is_mujocos():
     urdf = yourdfpy.URDF.load(io.StringIO(description.urdf()), load_meshes=False, load_collision_meshes=False)
     assert sorted(urdf.actuated_joint_names) == sorted(description.joint_names)
     assert_urdf_fk_is_mujocos(urdf, description, model, random_states(model, 12))
+
+
+def test_models_differing_only_in_actuators_share_one_description():
+    servo = '<actuator><position joint="h2" kp="{}"/></actuator></mujoco>'
+    tuned = [MODEL.replace("</mujoco>", servo.format(kp)) for kp in (10, 20)]
+    (model_a, a), (model_b, b) = described(tuned[0]), described(tuned[1])
+    assert model_a.actuator_gainprm[0, 0] == 10 and model_b.actuator_gainprm[0, 0] == 20  # each its own model
+    assert b is a and a.urdf() == describe(model_b).urdf()
+    moved = MODEL.replace('<body name="c" pos="0 0 0.2">', '<body name="c" pos="0 0 0.25">')
+    assert described(moved)[1].urdf() != a.urdf()
 
 
 def test_link_transforms_compose_to_mujocos_poses():

@@ -210,8 +210,16 @@ def test_series_encoded_in_numpy_equal_protobufs_byte_for_byte():
         for i, t in enumerate(times_ns)]
     assert robot.frame_transforms(times_ns, ["world"] * 2, children, trans, quats) == expected
     position = rng.uniform(0.1, 1, (5, 3))
+    position[:, -1] = 0.0  # messages that end in zero bytes keep them
     assert encode_series(schemas.JointState, {"name": NAMES}, {"position": position}) == \
         [schemas.JointState(name=NAMES, position=p).SerializeToString() for p in position]
+    from foxglove_schemas_protobuf.JointStates_pb2 import JointStates
+
+    drawn = rng.uniform(0.1, 1, (5, 2))
+    assert robot.joint_states(times_ns, children, drawn) == [JointStates(
+        timestamp={"seconds": int(t // 10**9), "nanos": int(t % 10**9)},
+        joints=[{"name": c, "position": p} for c, p in zip(children, row, strict=True)]).SerializeToString()
+        for t, row in zip(times_ns, drawn, strict=True)]
 
 
 def test_quaternions_equal_scipys_bit_for_bit():

@@ -9,7 +9,8 @@ what `SerializeToString` makes (tests hold the two equal), at a fraction of the 
 
 from __future__ import annotations
 
-import struct
+import functools
+from collections.abc import Callable
 from operator import itemgetter
 from typing import Any
 
@@ -82,7 +83,31 @@ def encode_series(cls: type[Message], constant: dict[str, Any],
 
 
 # ---------------------------------------------------------------------------------------------------
-# Messages of variable length (timestamps, nested messages), built column by column
+# Stamped messages: a timestamp, the one part whose length varies, and fields of fixed layout
+
+
+def delimited(number: int, length: int) -> bytes:
+    """The key and length of a length-delimited field (a string or a nested message)."""
+    return _varint(number << 3 | 2) + _varint(length)
+
+
+def string(number: int, text: str) -> bytes:
+    """A string field; nothing for the empty string, as proto3 writes no default."""
+    raw = text.encode()
+    return delimited(number, len(raw)) + raw if raw else b""
+
+
+_TAGGED_DOUBLE = np.dtype([("key", "u1"), ("value", "<f8")])  # packed: 9 bytes
+
+
+def doubles(numbers: list[int], values: np.ndarray) -> np.ndarray:
+    """(..., 9·len(numbers)) bytes: the fields `numbers` (type double) from the last axis of `values`, each key
+    then its float64. Zeros are written too: a decoder reads an explicit zero exactly like an absent field."""
+    values = np.asarray(values, dtype="<f8")
+    block = np.empty(values.shape, dtype=_TAGGED_DOUBLE)
+    block["key"] = [number << 3 | 1 for number in numbers]
+    block["value"] = values
+    return block.view(np.uint8).reshape(*values.shape[:-1], 9 * len(numbers))
 
 
 def _varints(values: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
@@ -106,118 +131,59 @@ def _varints(values: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
     return (out, None) if used.min() == out.shape[1] else (out, used)
 
 
-class Rows:
-    """N protobuf messages of one type, serialized column by column in NumPy.
-
-    Add the fields in field-number order: `constant` bytes the same in every row, `doubles` (tagged float64
-    per row), `varint` (an integer per row), `message` (a nested Rows, length-delimited). `serialize()`
-    returns one `bytes` per row. Every double is written, zeros included (a decoder reads an explicit zero
-    exactly like an absent proto3 field), so rows differ in length only through varints."""
-
-    def __init__(self, n: int):
-        self.n = n
-        # bytes the same in every row (runs of them merged), or (N, w) bytes per row with the count used of
-        # each row (None where every row uses all w)
-        self._parts: list[bytes | tuple[np.ndarray, np.ndarray | None]] = []
-        self._width = 0  # bytes of every row, besides the used bytes of the variable parts
-        self._variable: list[np.ndarray] = []
-
-    def _add(self, part: bytes | tuple[np.ndarray, np.ndarray | None]) -> Rows:
-        if isinstance(part, bytes):
-            if not part:
-                return self
-            self._width += len(part)
-            if self._parts and isinstance(self._parts[-1], bytes):
-                part = self._parts.pop() + part
-        elif part[1] is None:
-            self._width += part[0].shape[1]
-        else:
-            self._variable.append(part[1])
-        self._parts.append(part)
-        return self
-
-    def constant(self, data: bytes) -> Rows:
-        return self._add(data)
-
-    def string(self, number: int, text: str) -> Rows:
-        raw = text.encode()
-        return self.constant(_varint(number << 3 | 2) + _varint(len(raw)) + raw) if raw else self
-
-    def doubles(self, numbers: list[int], values: np.ndarray) -> Rows:
-        """Fields `numbers` (type double) from the columns of `values` (N, len(numbers))."""
-        values = np.asarray(values, dtype="<f8").reshape(self.n, len(numbers))
-        block = np.empty((self.n, len(numbers), 9), dtype=np.uint8)
-        block[:, :, 0] = [number << 3 | 1 for number in numbers]
-        block[:, :, 1:] = np.ascontiguousarray(values).view(np.uint8).reshape(self.n, len(numbers), 8)
-        return self._add((block.reshape(self.n, -1), None))
-
-    def _integers(self, values: np.ndarray) -> Rows:
-        values = np.asarray(values)
-        if len(values) and (values == values[0]).all():  # the same in every row: a constant
-            return self.constant(_varint(int(values[0])))
-        return self._add(_varints(values))
-
-    def varint(self, number: int, values: np.ndarray) -> Rows:
-        return self.constant(_varint(number << 3))._integers(values)
-
-    def message(self, number: int, inner: Rows) -> Rows:
-        self.constant(_varint(number << 3 | 2))._integers(inner.lengths())
-        for part in inner._parts:
-            self._add(part)
-        return self
-
-    def lengths(self) -> np.ndarray:
-        total = np.full(self.n, self._width, dtype=np.int64)
-        for used in self._variable:
-            total += used
-        return total
-
-    def serialize(self) -> list[bytes]:
-        """One `bytes` per row. Rows whose varints have the same lengths share one layout: each such group is
-        cut from one table in C, with no per-row work in Python."""
-        if not self._parts:
-            return [b""] * self.n
-        table = np.concatenate([np.broadcast_to(np.frombuffer(part, dtype=np.uint8), (self.n, len(part)))
-                                if isinstance(part, bytes) else part[0] for part in self._parts], axis=1)
-        variable = [(k, used) for k, used in enumerate(map(_used, self._parts)) if used is not None]
-        if not variable:
-            return _split(table)
-        starts = np.cumsum([0] + [_width(part) for part in self._parts])
-        # rows whose varints have the same lengths (a varint has 1 to 10 bytes): one key per layout
-        key = np.zeros(self.n, dtype=object if len(variable) > 18 else np.int64)
-        for _, used in variable:
-            key = key * 11 + used
-        keys, group = np.unique(key, return_inverse=True)
-        if len(keys) == 1:
-            group_rows = [np.arange(self.n)]
-        else:
-            group_rows = [np.flatnonzero(group == g) for g in range(len(keys))]
-        pieces: list[bytes] = []
-        for rows in group_rows:
-            signature = [int(used[rows[0]]) for _, used in variable]
-            block = table[rows]
-            keep, start = [], 0  # column ranges of this layout: each variable part cut to its used bytes
-            for (k, _), u in zip(variable, signature, strict=True):
-                keep.append(block[:, start:starts[k] + u])
-                start = starts[k + 1]
-            keep.append(block[:, start:])
-            pieces += _split(np.concatenate(keep, axis=1))
-        if len(group_rows) == 1:
-            return pieces
-        order = np.argsort(np.concatenate(group_rows)).tolist()  # back to row order
-        return [pieces[order[0]]] if self.n == 1 else list(itemgetter(*order)(pieces))
+Part = bytes | np.ndarray  # the same bytes in every row, or (m, w) bytes, one row per message
 
 
-def _width(part: bytes | tuple[np.ndarray, np.ndarray | None]) -> int:
-    return len(part) if isinstance(part, bytes) else part[0].shape[1]
+def stamped(times_ns: np.ndarray, layout: Callable[[np.ndarray, np.ndarray], list[Part]]) -> list[bytes]:
+    """One serialized message per time. `layout(rows, stamp)` gives, in field order, the parts of the messages
+    of `rows` (indices), whose `google.protobuf.Timestamp` encodings `stamp` ((m, s) bytes: seconds and nanos,
+    both written) have the same length s. The nanos varint is the only part whose length varies, so the rows
+    of each length are one table, cut into messages in C."""
+    times_ns = np.asarray(times_ns, dtype=np.int64)
+    if not len(times_ns):
+        return []
+    groups = _timestamps(times_ns.tobytes())
+    pieces: list[bytes] = []
+    for rows, stamp in groups:
+        pieces += _split(_table(layout(rows, stamp), len(rows)))
+    if len(groups) == 1:
+        return pieces
+    order = np.argsort(np.concatenate([rows for rows, _ in groups])).tolist()  # back to time order
+    return list(itemgetter(*order)(pieces))
 
 
-def _used(part: bytes | tuple[np.ndarray, np.ndarray | None]) -> np.ndarray | None:
-    return None if isinstance(part, bytes) else part[1]
+@functools.lru_cache(maxsize=4)  # a run's drawing topics share their times
+def _timestamps(times: bytes) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The rows of `times` (int64 ns) grouped by the length of their encoded Timestamp: (rows, stamps)."""
+    times_ns = np.frombuffer(times, dtype=np.int64)
+    n = len(times_ns)
+    (seconds, seconds_used), (nanos, nanos_used) = (_varints(v) for v in np.divmod(times_ns, 1_000_000_000))
+    seconds_used = np.full(n, seconds.shape[1]) if seconds_used is None else seconds_used
+    nanos_used = np.full(n, nanos.shape[1]) if nanos_used is None else nanos_used
+    length = seconds_used * 11 + nanos_used  # a varint has 1 to 10 bytes: one key per stamp layout
+    lengths = np.unique(length)
+    groups = []
+    for rows in [np.arange(n)] if len(lengths) == 1 else [np.flatnonzero(length == g) for g in lengths]:
+        first = rows[0]
+        stamp = _table([b"\x08", seconds[rows, :seconds_used[first]], b"\x10", nanos[rows, :nanos_used[first]]],
+                       len(rows))
+        rows.flags.writeable = stamp.flags.writeable = False  # shared by every caller with these times
+        groups.append((rows, stamp))
+    return groups
+
+
+def _table(parts: list[Part], m: int) -> np.ndarray:
+    widths = [len(part) if isinstance(part, bytes) else part.shape[1] for part in parts]
+    table = np.empty((m, sum(widths)), dtype=np.uint8)
+    start = 0
+    for part, width in zip(parts, widths, strict=True):
+        table[:, start:start + width] = np.frombuffer(part, dtype=np.uint8) if isinstance(part, bytes) else part
+        start += width
+    return table
 
 
 def _split(table: np.ndarray) -> list[bytes]:
-    """The rows of a (N, w) uint8 table as `bytes`, cut in C (a third of the cost of slicing in a Python loop)."""
+    """The rows of a (N, w) uint8 table as `bytes`, made in C (a void scalar's Python value is its bytes)."""
     if not table.shape[1]:
         return [b""] * len(table)
-    return list(map(itemgetter(0), struct.iter_unpack(f"{table.shape[1]}s", np.ascontiguousarray(table).tobytes())))
+    return np.ascontiguousarray(table).view(f"V{table.shape[1]}").ravel().tolist()

@@ -19,7 +19,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from pipeline.core.encoding import Rows
+from pipeline.core import encoding
 
 ROBOT_DESCRIPTION = "/robot_description"
 JOINT_STATES = "/joint_states"
@@ -53,32 +53,43 @@ def thinned(times: np.ndarray, rate_hz: float = VIEW_RATE_HZ) -> np.ndarray:
     return keep if keep[-1] == n - 1 else np.append(keep, n - 1)
 
 
-def _timestamp(times_ns: np.ndarray) -> Rows:
-    seconds, nanos = np.divmod(np.asarray(times_ns, dtype=np.int64), 1_000_000_000)
-    return Rows(len(times_ns)).varint(1, seconds).varint(2, nanos)
-
-
 def frame_transforms(times_ns: np.ndarray, parents: Sequence[str], children: Sequence[str],
                      translations: np.ndarray, quats_wxyz: np.ndarray) -> list[bytes]:
     """`foxglove.FrameTransforms` messages, one per time: child k at translations[:, k] (m), rotation
     quats_wxyz[:, k] in parents[k], stamped with the time."""
-    n = len(times_ns)
-    translations = np.asarray(translations, dtype=float).reshape(n, len(children), 3)
-    quats = np.asarray(quats_wxyz, dtype=float).reshape(n, len(children), 4)[..., [1, 2, 3, 0]]  # wire: x y z w
-    stamp = _timestamp(times_ns)
-    rows = Rows(n)
-    for k, (parent, child) in enumerate(zip(parents, children, strict=True)):
-        rows.message(1, Rows(n).message(1, stamp).string(2, parent).string(3, child)
-                     .message(4, Rows(n).doubles([1, 2, 3], translations[:, k]))
-                     .message(5, Rows(n).doubles([1, 2, 3, 4], quats[:, k])))
-    return rows.serialize()
+    n, k = len(times_ns), len(children)
+    translation = encoding.doubles([1, 2, 3], np.asarray(translations, dtype=float).reshape(n, k, 3))
+    rotation = encoding.doubles([1, 2, 3, 4],  # on the wire: x y z w
+                                np.asarray(quats_wxyz, dtype=float).reshape(n, k, 4)[..., [1, 2, 3, 0]])
+    rotation_key = np.frombuffer(encoding.delimited(5, rotation.shape[-1]), dtype=np.uint8)
+    # each transform's fields after its names, one block: translation (4), rotation (5)
+    pose = np.concatenate([translation, np.broadcast_to(rotation_key, (n, k, len(rotation_key))), rotation], axis=2)
+    frames = [encoding.string(2, parent) + encoding.string(3, child) + encoding.delimited(4, translation.shape[-1])
+              for parent, child in zip(parents, children, strict=True)]
+
+    def layout(rows: np.ndarray, stamp: np.ndarray) -> list[encoding.Part]:
+        poses = pose if len(rows) == n else pose[rows]
+        timestamp = encoding.delimited(1, stamp.shape[1])
+        parts: list[encoding.Part] = []
+        for j, frame in enumerate(frames):
+            size = len(timestamp) + stamp.shape[1] + len(frame) + pose.shape[-1]
+            parts += [encoding.delimited(1, size) + timestamp, stamp, frame, poses[:, j]]
+        return parts
+
+    return encoding.stamped(times_ns, layout)
 
 
 def joint_states(times_ns: np.ndarray, names: Sequence[str], positions: np.ndarray) -> list[bytes]:
     """`foxglove.JointStates` messages, one per time, with each named joint's position (rad or m)."""
     n = len(times_ns)
-    positions = np.asarray(positions, dtype=float).reshape(n, len(names))
-    rows = Rows(n).message(1, _timestamp(times_ns))
-    for k, name in enumerate(names):
-        rows.message(2, Rows(n).string(1, name).doubles([2], positions[:, k]))
-    return rows.serialize()
+    positions = encoding.doubles([2], np.asarray(positions, dtype=float).reshape(n, len(names), 1))
+    joints = [encoding.string(1, name) for name in names]
+
+    def layout(rows: np.ndarray, stamp: np.ndarray) -> list[encoding.Part]:
+        values = positions if len(rows) == n else positions[rows]
+        parts: list[encoding.Part] = [encoding.delimited(1, stamp.shape[1]), stamp]
+        for j, joint in enumerate(joints):
+            parts += [encoding.delimited(2, len(joint) + values.shape[-1]) + joint, values[:, j]]
+        return parts
+
+    return encoding.stamped(times_ns, layout)

@@ -89,17 +89,20 @@ def log_timings(log: RunWriter, timings: Sequence[Timing], start: float = 0.0, s
 
 
 def time_interleaved(calls: Mapping[str, tuple[Callable[..., Any], tuple, int]], *, warmup: int = 1,
-                     repeats: int = 1) -> dict[str, Timing]:
+                     repeats: int = 1, clock: Callable[[], int] = time.perf_counter_ns,
+                     collect: bool = False) -> dict[str, Timing]:
     """Time several calls in rounds, each round calling every one once in turn, so that a change of load
     on a shared machine during the measurement falls on all of them alike (what ratios between
-    algorithms and scaling fits need). `calls` maps name -> (fn, args, items_per_call)."""
+    algorithms and scaling fits need). `calls` maps name -> (fn, args, items_per_call). Wall time by
+    default (`clock=time.process_time_ns`: this process's CPU time); garbage collection is off unless
+    `collect` (whole runs, which collect as the pipeline does)."""
     for fn, args, _ in calls.values():
         for _ in range(warmup):
             fn(*args)
-    clock = time.perf_counter_ns
     samples = {name: np.empty(repeats) for name in calls}
     enabled = gc.isenabled()
-    gc.disable()
+    if not collect:
+        gc.disable()
     try:
         for r in range(repeats):
             for name, (fn, args, _) in calls.items():

@@ -195,16 +195,12 @@ class RobotDescription:
         """Pose of each movable joint's child link in its parent link (what robot_state_publisher sends):
         translations (N, k, 3) and wxyz quaternions (N, k, 4) for joint positions (N, k)."""
         positions = np.atleast_2d(positions)
-        n, k = positions.shape
-        trans, quats = np.empty((n, k, 3)), np.empty((n, k, 4))
-        for column, j in enumerate(self.movable):
-            q = positions[:, column]
-            if j.kind == "prismatic":
-                trans[:, column] = j.origin.p + _rotate(j.origin.q, j.axis) * q[:, None]
-                quats[:, column] = j.origin.q
-            else:
-                trans[:, column] = j.origin.p
-                quats[:, column] = _quat_mul(j.origin.q, _axis_angle(j.axis, q))
+        origins = np.array([j.origin.p for j in self.movable]).reshape(-1, 3)
+        rotations = np.array([j.origin.q for j in self.movable]).reshape(-1, 4)
+        axes = np.array([j.axis for j in self.movable], dtype=float).reshape(-1, 3)
+        sliding = np.array([j.kind == "prismatic" for j in self.movable], dtype=bool)
+        trans = origins + np.where(sliding[:, None], _rotate(rotations, axes) * positions[..., None], 0.0)
+        quats = _quat_mul(rotations, _axis_angle(axes, np.where(sliding, 0.0, positions)))
         return trans, quats
 
 
@@ -309,14 +305,23 @@ def _stick_visuals(model, b: int) -> list[str]:
     return out
 
 
-@functools.lru_cache(maxsize=8)
+_ACTUATORS = re.compile(r"<actuator>.*?</actuator>", re.DOTALL)
+_DESCRIPTIONS: dict[str, RobotDescription] = {}  # MJCF text without its actuators -> description (a few)
+
+
 def described(xml: str) -> tuple[Any, RobotDescription]:
     """The compiled `MjModel` of an MJCF text (shared with mjcf.servo_rollout, read-only) and its robot
-    description, made once per process for each model (the runs a process logs mostly draw the same robot)."""
+    description. A description is made once per process for each robot: actuators move nothing a
+    description draws, so the runs of a stage whose models differ only in their servo gains share it."""
     from pipeline.robotics.mjcf import compiled
 
     model = compiled(xml)
-    return model, describe(model)
+    key = _ACTUATORS.sub("", xml)
+    if key not in _DESCRIPTIONS:
+        if len(_DESCRIPTIONS) >= 8:
+            del _DESCRIPTIONS[next(iter(_DESCRIPTIONS))]
+        _DESCRIPTIONS[key] = describe(model)
+    return model, _DESCRIPTIONS[key]
 
 
 def describe(model, name: str | None = None) -> RobotDescription:
