@@ -121,7 +121,7 @@ def with_servo_gains(build: Callable[[np.ndarray, np.ndarray], str], q0: np.ndar
     q0: kp = m·ω², kv = 2ζ·m·ω, m the diagonal of the joint-space inertia (armature included) at q0."""
     import mujoco
 
-    model = mujoco.MjModel.from_xml_string(build(np.zeros(len(q0)), np.zeros(len(q0))))
+    model = compiled(build(np.zeros(len(q0)), np.zeros(len(q0))))  # the same for every run of a stage: once
     data = mujoco.MjData(model)
     data.qpos[:] = q0
     mujoco.mj_forward(model, data)
