@@ -23,6 +23,8 @@ if TYPE_CHECKING:
 # One BLAS thread per process: the pipeline runs one process per core, and compute times are single-threaded.
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
+# No OpenGL: the pipeline never renders with MuJoCo, and `import mujoco` loading GLFW cost every stage 50 ms.
+os.environ.setdefault("MUJOCO_GL", "disable")
 
 
 def main() -> None:
