@@ -50,13 +50,32 @@ def link_transforms(dh: DH, q: np.ndarray) -> np.ndarray:
 
 def frames(dh: DH, q: np.ndarray) -> np.ndarray:
     """(..., n+1, 4, 4): ^0T_i for i = 0 … n (frame 0 is the identity)."""
-    # joint index first, every operand contiguous: NumPy's matmul over strided stacks is 2.5× slower
-    links = np.ascontiguousarray(np.moveaxis(link_transforms(dh, q), -3, 0))
-    out = np.empty((dh.n + 1, *links.shape[1:]))
-    out[0] = np.eye(4)
+    # ^0T_i = ^0T_{i-1} · Rz(θ) Tz(d) Tx(a) Rx(α), applied to the columns (x, y, z, p) of ^0T_{i-1}:
+    #   x' = c x + s y,  y' = cα (c y − s x) + sα z,  z' = cα z − sα (c y − s x),  p' = p + d z + a x'.
+    # Columns are (3, N) rows of samples: a dozen array operations per joint, 2× faster than 4×4 matmuls.
+    q = np.asarray(q, dtype=float)
+    theta = np.ascontiguousarray((q + dh.theta_offset).reshape(-1, dh.n).T)
+    ct, st = np.cos(theta), np.sin(theta)
+    ca, sa = np.cos(dh.alpha), np.sin(dh.alpha)
+    out = np.empty((dh.n + 1, 4, 4, theta.shape[1]))  # frame, row, column, sample
+    out[0] = np.eye(4)[..., None]
+    out[1:, 3] = np.array([0.0, 0.0, 0.0, 1.0])[:, None]
     for i in range(dh.n):
-        np.matmul(out[i], links[i], out=out[i + 1])
-    return np.moveaxis(out, 0, -3)
+        x, y, z, p = (out[i, :3, k] for k in range(4))
+        x1, y1, z1, p1 = (out[i + 1, :3, k] for k in range(4))
+        c, s = ct[i], st[i]
+        np.multiply(x, c, out=x1)
+        x1 += y * s
+        turned = y * c
+        turned -= x * s
+        np.multiply(turned, ca[i], out=y1)
+        y1 += z * sa[i]
+        np.multiply(z, ca[i], out=z1)
+        z1 -= turned * sa[i]
+        np.multiply(x1, dh.a[i], out=p1)
+        p1 += z * dh.d[i]
+        p1 += p
+    return np.moveaxis(out, -1, 0).reshape(*q.shape[:-1], dh.n + 1, 4, 4)
 
 
 def fk(dh: DH, q: np.ndarray) -> np.ndarray:

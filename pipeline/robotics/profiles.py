@@ -42,3 +42,14 @@ def septic(tau: np.ndarray) -> np.ndarray:
     d2 = 420 * t ** 2 * (1 - t) ** 2 * (1 - 2 * t)
     d3 = 840 * t * (1 - t) * (1 - 5 * t + 5 * t ** 2)
     return np.stack([s, d1 * inside, d2 * inside, d3 * inside])
+
+
+def interpolate(t: np.ndarray, times: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Rows of `values` (N, ...) sampled at increasing `times` (N,), linearly interpolated at each of `t` and
+    held outside [times[0], times[-1]]: np.interp for every column at once (its values at the samples exactly)."""
+    t, times, values = np.asarray(t, dtype=float), np.asarray(times, dtype=float), np.asarray(values, dtype=float)
+    if len(times) == 1:
+        return np.repeat(values, len(t), axis=0)
+    k = np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 2)
+    w = np.clip((t - times[k]) / (times[k + 1] - times[k]), 0.0, 1.0).reshape(-1, *(1,) * (values.ndim - 1))
+    return (1 - w) * values[k] + w * values[k + 1]

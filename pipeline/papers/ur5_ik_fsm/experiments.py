@@ -17,6 +17,7 @@ from pipeline.papers.ur5_ik_fsm import ik
 from pipeline.papers.ur5_ik_fsm.kinematics import Geometry, det_j, fk, shoulder_term
 from pipeline.robotics import dh as dhk
 from pipeline.robotics.mjcf import servo_rollout
+from pipeline.robotics.profiles import interpolate
 from pipeline.robotics.transforms import rotation_angle
 
 JOINTS = [f"joint{i}" for i in range(1, 7)]
@@ -185,8 +186,7 @@ def log_execution(log: RunWriter, cfg: DictConfig, g: Geometry, times, q_ref, qd
     err = q_ref - q
     log.log_series("/tracking_error", t_state, units="rad", name=JOINTS, error=err, norm=np.linalg.norm(err, axis=1))
     # flange error of the executed motion against the desired path
-    T_des = np.stack([np.interp(t_state, ik_times, poses[:, i, j]) for i in range(4) for j in range(4)],
-                     axis=1).reshape(-1, 4, 4)
+    T_des = interpolate(t_state, ik_times, poses)
     link_frames = dhk.frames(dh, q)
     T_act = link_frames[:, -1]
     dp = T_des[:, :3, 3] - T_act[:, :3, 3]
