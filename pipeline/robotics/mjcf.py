@@ -115,20 +115,93 @@ def serial_arm(name: str, dh: DH, dyn: ArmDynamics, *, timestep: float, kp: Sequ
 """
 
 
+class ServoMJCF(str):
+    """An MJCF text from `with_servo_gains`: the text itself (attached to runs, compiled by whoever needs the
+    model) that also knows its zero-gain text and its gains, so `servo_rollout` sets the gains on the stage's
+    one servo model instead of compiling the text again."""
+
+    zero: str
+    kp: np.ndarray
+    kv: np.ndarray
+
+
 def with_servo_gains(build: Callable[[np.ndarray, np.ndarray], str], q0: np.ndarray, bandwidth_hz: float,
-                     damping_ratio: float) -> str:
+                     damping_ratio: float) -> ServoMJCF:
     """The MJCF `build(kp, kv)` makes, with each joint servo tuned to a natural frequency and damping ratio at
     q0: kp = m·ω², kv = 2ζ·m·ω, m the diagonal of the joint-space inertia (armature included) at q0."""
     import mujoco
 
-    model = compiled(build(np.zeros(len(q0)), np.zeros(len(q0))))  # the same for every run of a stage: once
-    data = mujoco.MjData(model)
-    data.qpos[:] = q0
-    mujoco.mj_forward(model, data)
-    inertia = np.zeros((model.nv, model.nv))
-    mujoco.mj_fullM(model, data, inertia)
+    zero = build(np.zeros(len(q0)), np.zeros(len(q0)))  # the same for every run of a stage
+    servo = _servo(zero, build)
+    servo.data.qpos[:] = q0
+    mujoco.mj_forward(servo.model, servo.data)  # the inertia does not depend on the gains the model holds
+    inertia = np.zeros((servo.model.nv, servo.model.nv))
+    mujoco.mj_fullM(servo.model, servo.data, inertia)
     m, w = np.diag(inertia), 2 * np.pi * bandwidth_hz
-    return build(m * w * w, 2 * damping_ratio * m * w)
+    kp, kv = m * w * w, 2 * damping_ratio * m * w
+    xml = ServoMJCF(build(kp, kv))
+    xml.zero, xml.kp, xml.kv = zero, kp, kv
+    return xml
+
+
+@dataclass
+class _Servo:
+    """A stage's servo model (its own, mutable: each run sets its gains), its data, and how the gains enter
+    the actuators: (gainprm, biasprm) = zero + per_kp · kp[dof] + per_kv · kv[dof], from the zero-gain model
+    and two probe compiles (MJCF's position and velocity servos are linear in kp and kv). `linear` is False
+    when the probes differ in anything else; runs then compile their own text."""
+
+    model: object
+    data: object
+    dof: np.ndarray  # the joint dof each actuator drives
+    zero: np.ndarray  # (2, nu, 10): gainprm and biasprm at zero gains
+    per_kp: np.ndarray
+    per_kv: np.ndarray
+    linear: bool
+
+    def with_gains(self, kp: np.ndarray, kv: np.ndarray):
+        import mujoco
+
+        gains = self.zero + self.per_kp * kp[self.dof, None] + self.per_kv * kv[self.dof, None]
+        self.model.actuator_gainprm[:], self.model.actuator_biasprm[:] = gains
+        mujoco.mj_resetData(self.model, self.data)
+        return self.model, self.data
+
+
+_SERVOS: dict[str, _Servo] = {}
+
+
+def _servo(zero: str, build: Callable[[np.ndarray, np.ndarray], str]) -> _Servo:
+    """The servo model of a zero-gain MJCF text, made once per process (a few stages' worth are kept)."""
+    import mujoco
+
+    servo = _SERVOS.get(zero)
+    if servo is None:
+        model = mujoco.MjModel.from_xml_string(zero)
+        n = model.nv
+        probes = [mujoco.MjModel.from_xml_string(build(np.full(n, p), np.full(n, v))) for p, v in ((1.0, 0.0),
+                                                                                                   (0.0, 1.0))]
+        zero_gains, kp_gains, kv_gains = (np.stack([m.actuator_gainprm, m.actuator_biasprm])
+                                          for m in (model, *probes))
+        for probe in probes:  # with the zero model's gains, a probe must be the zero model byte for byte
+            probe.actuator_gainprm[:], probe.actuator_biasprm[:] = zero_gains
+        linear = ((model.actuator_trntype == mujoco.mjtTrn.mjTRN_JOINT).all()
+                  and all(np.array_equal(_saved(probe), _saved(model)) for probe in probes))
+        servo = _Servo(model, mujoco.MjData(model), model.jnt_dofadr[model.actuator_trnid[:, 0]], zero_gains,
+                       kp_gains - zero_gains, kv_gains - zero_gains, bool(linear))
+        if len(_SERVOS) >= 8:
+            del _SERVOS[next(iter(_SERVOS))]
+        _SERVOS[zero] = servo
+    return servo
+
+
+def _saved(model) -> np.ndarray:
+    """A model as MuJoCo saves it (MJB): every array and name, to compare two models at once."""
+    import mujoco
+
+    buffer = np.empty(mujoco.mj_sizeModel(model), dtype=np.uint8)
+    mujoco.mj_saveModel(model, None, buffer)
+    return buffer
 
 
 # What a config of an IK-then-servo experiment (servo_rollout) must satisfy between its time steps.
@@ -144,8 +217,9 @@ SERVO_RULES = (
 
 @functools.lru_cache(maxsize=8)
 def compiled(xml: str):
-    """The `MjModel` of an MJCF text, compiled once per process (a run's servo and its robot drawing share it).
-    Read-only: whoever needs to change a model compiles their own."""
+    """The `MjModel` of an MJCF text, compiled once per process (a run's servo and its robot drawing share it,
+    unless the servo's gains are set on its stage's model: `with_servo_gains`). Read-only: whoever needs to
+    change a model compiles their own."""
     import mujoco
 
     return mujoco.MjModel.from_xml_string(xml)
@@ -160,8 +234,12 @@ def servo_rollout(xml: str, q_ref: np.ndarray, qd_ref: np.ndarray, times: np.nda
     import mujoco
     from mujoco import rollout
 
-    model = compiled(xml)
-    data = mujoco.MjData(model)
+    servo = _SERVOS.get(xml.zero) if isinstance(xml, ServoMJCF) else None
+    if servo is not None and servo.linear:  # the stage's servo model with this run's gains: no compile
+        model, data = servo.with_gains(xml.kp, xml.kv)
+    else:
+        model = compiled(xml)
+        data = mujoco.MjData(model)
     data.qpos[:] = q_ref[0]
     if moving_start:
         data.qvel[:] = qd_ref[0]

@@ -306,22 +306,23 @@ def _stick_visuals(model, b: int) -> list[str]:
 
 
 _ACTUATORS = re.compile(r"<actuator>.*?</actuator>", re.DOTALL)
-_DESCRIPTIONS: dict[str, RobotDescription] = {}  # MJCF text without its actuators -> description (a few)
+# MJCF text without its actuators -> (a model of that robot, its description), for a few robots
+_DESCRIPTIONS: dict[str, tuple[Any, RobotDescription]] = {}
 
 
 def described(xml: str) -> tuple[Any, RobotDescription]:
-    """The compiled `MjModel` of an MJCF text (shared with mjcf.servo_rollout, read-only) and its robot
-    description. A description is made once per process for each robot: actuators move nothing a
-    description draws, so the runs of a stage whose models differ only in their servo gains share it."""
+    """A compiled `MjModel` of the robot of an MJCF text (read-only) and its robot description, made once per
+    process for each robot: actuators move nothing a drawing reads, so the runs of a stage whose models
+    differ only in their servo gains share both (the model is the first of them; simulate with your own)."""
     from pipeline.robotics.mjcf import compiled
 
-    model = compiled(xml)
     key = _ACTUATORS.sub("", xml)
     if key not in _DESCRIPTIONS:
         if len(_DESCRIPTIONS) >= 8:
             del _DESCRIPTIONS[next(iter(_DESCRIPTIONS))]
-        _DESCRIPTIONS[key] = describe(model)
-    return model, _DESCRIPTIONS[key]
+        model = compiled(xml)
+        _DESCRIPTIONS[key] = model, describe(model)
+    return _DESCRIPTIONS[key]
 
 
 def describe(model, name: str | None = None) -> RobotDescription:

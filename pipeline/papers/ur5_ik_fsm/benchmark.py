@@ -18,7 +18,7 @@ from pipeline.core.timing import best_of, time_calls, time_interleaved
 from pipeline.papers.ur5_ik_fsm import experiments as ex
 from pipeline.papers.ur5_ik_fsm import ik
 from pipeline.robotics import dh as dhk
-from pipeline.robotics.mjcf import compiled, servo_rollout
+from pipeline.robotics.mjcf import _SERVOS, compiled, servo_rollout
 from pipeline.robotics.urdf import describe
 
 
@@ -35,26 +35,26 @@ def execution(rows: list[dict]) -> None:
     model = mujoco.MjModel.from_xml_string(xml)
     data = mujoco.MjData(model)
 
-    def bare(model=model, data=data) -> None:
+    def bare() -> None:
         mujoco.mj_resetData(model, data)
         data.qpos[:] = q_ref[0]
         step = mujoco.mj_step
         for _ in range(steps):
             step(model, data)
 
-    def bare_run() -> None:  # a run without servo or logging: its model compiled, its data made, then stepped
-        run_model = mujoco.MjModel.from_xml_string(xml)
-        bare(run_model, mujoco.MjData(run_model))
+    def servo() -> None:  # a run's control, as in a stage: gains tuned at its start, set on the servo model
+        servo_rollout(ex.arm_model(cfg, g, q_ref[0]), q_ref, qd_ref, times)
 
-    def servo() -> None:  # as a run's first use of its model (its servo gains are its own): compiled afresh
-        compiled.cache_clear()
-        servo_rollout(xml, q_ref, qd_ref, times)
+    def servo_model() -> None:  # what a stage's first run adds: the zero-gain model and its two gain probes
+        _SERVOS.clear()
+        ex.arm_model(cfg, g, q_ref[0])
 
     states, sensors = servo_rollout(xml, q_ref, qd_ref, times)
-    t_describe = best_of(lambda: describe(compiled(xml)), 5)
     system = "MuJoCo UR5, wrist path (4 s, 1 kHz)"
-    rows.append({"what": system, "measure": "robot description (URDF), once per process", "value": t_describe * 1e3,
-                 "unit": "ms"})
+    rows += [{"what": system, "measure": "servo model (three compiles), once per stage",
+              "value": best_of(servo_model, 5) * 1e3, "unit": "ms"},
+             {"what": system, "measure": "robot description (URDF), once per process",
+              "value": best_of(lambda: describe(compiled(xml)), 5) * 1e3, "unit": "ms"}]
     with tempfile.TemporaryDirectory() as tmp:
         files = (Path(tmp) / f"{k}.mcap" for k in itertools.count())
         path = next(files)
@@ -76,8 +76,8 @@ def execution(rows: list[dict]) -> None:
                 logging_only()
 
             # bare stepping and whole runs in turn, 15 rounds: medians, in wall and in this process's CPU time
-            calls = {"bare": (bare, (), 1), "bare run": (bare_run, (), 1), "servo": (servo, (), 1),
-                     "logging": (logging_only, (), 1), "full": (full, (), 1)}
+            calls = {"bare": (bare, (), 1), "servo": (servo, (), 1), "logging": (logging_only, (), 1),
+                     "full": (full, (), 1)}
             wall, cpu = (time_interleaved(calls, warmup=2, repeats=15, clock=clock, collect=True)
                          for clock in (time.perf_counter_ns, time.process_time_ns))
             run = read_run(path)
@@ -87,7 +87,7 @@ def execution(rows: list[dict]) -> None:
             if label == "default":
                 rows += [{"what": system, "measure": "bare mj_step loop", "value": wall["bare"].median / steps * 1e6,
                           "unit": "µs/step"},
-                         {"what": system, "measure": "servoed run (rollout, servo in C)",
+                         {"what": system, "measure": "servoed run (gains tuned, rollout with the servo in C)",
                           "value": wall["servo"].median / steps * 1e6, "unit": "µs/step"}]
             rows += [
                 {"what": system, "measure": f"messages per run (every topic, the robot drawing included), {rate}",
@@ -100,8 +100,6 @@ def execution(rows: list[dict]) -> None:
                  "value": wall["full"].median / wall["bare"].median, "unit": "×", "goal": "≤ 2"},
                 {"what": system, "measure": f"the same in CPU time (this process), {rate}",
                  "value": cpu["full"].median / cpu["bare"].median, "unit": "×", "goal": "≤ 2"},
-                {"what": system, "measure": f"the same over a bare run (model compiled and its data made on both "
-                 f"sides), CPU time, {rate}", "value": cpu["full"].median / cpu["bare run"].median, "unit": "×"},
                 {"what": system, "measure": f"simulated seconds per wall second, {rate}",
                  "value": sim_seconds / wall["full"].median, "unit": "s/s"},
             ]
