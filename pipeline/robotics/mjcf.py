@@ -217,9 +217,8 @@ SERVO_RULES = (
 
 @functools.lru_cache(maxsize=8)
 def compiled(xml: str):
-    """The `MjModel` of an MJCF text, compiled once per process (a run's servo and its robot drawing share it,
-    unless the servo's gains are set on its stage's model: `with_servo_gains`). Read-only: whoever needs to
-    change a model compiles their own."""
+    """The `MjModel` of an MJCF text, compiled once per process. Read-only: whoever needs to change a model
+    compiles their own."""
     import mujoco
 
     return mujoco.MjModel.from_xml_string(xml)
