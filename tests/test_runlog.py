@@ -197,7 +197,7 @@ def test_series_encoded_in_numpy_equal_protobufs_byte_for_byte():
     from foxglove_schemas_protobuf.FrameTransforms_pb2 import FrameTransforms
 
     from pipeline.core import robot
-    from pipeline.core.encoding import encode_series
+    from pipeline.core.encoding import encode_series, messages
 
     rng = np.random.default_rng(4)
     times_ns = np.array([1_000_000_001, 300 * 10**9 + 999, 2_000_000_000 + 10**8, 5 * 10**9 + 7, 1_500_000_000])
@@ -211,7 +211,7 @@ def test_series_encoded_in_numpy_equal_protobufs_byte_for_byte():
     assert robot.frame_transforms(times_ns, ["world"] * 2, children, trans, quats) == expected
     position = rng.uniform(0.1, 1, (5, 3))
     position[:, -1] = 0.0  # messages that end in zero bytes keep them
-    assert encode_series(schemas.JointState, {"name": NAMES}, {"position": position}) == \
+    assert messages(encode_series(schemas.JointState, {"name": NAMES}, {"position": position})) == \
         [schemas.JointState(name=NAMES, position=p).SerializeToString() for p in position]
     from foxglove_schemas_protobuf.JointStates_pb2 import JointStates
 

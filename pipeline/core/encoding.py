@@ -68,9 +68,10 @@ def series_layout(cls: type[Message], constant: dict[str, Any],
 
 
 def encode_series(cls: type[Message], constant: dict[str, Any],
-                  per_sample: dict[str, np.ndarray]) -> list[bytes] | None:
-    """Serialized messages, one per row of the `per_sample` arrays; None if the fast layout does not apply
-    (a per-sample field that is not a double), so the caller falls back to protobuf."""
+                  per_sample: dict[str, np.ndarray]) -> np.ndarray | None:
+    """Serialized messages, one per row of the `per_sample` arrays, as the rows of one (n, w) uint8 table
+    (`messages` makes them `bytes`); None if the fast layout does not apply (a per-sample field that is not a
+    double), so the caller falls back to protobuf."""
     layout = series_layout(cls, constant, per_sample)
     if layout is None:
         return None
@@ -79,7 +80,7 @@ def encode_series(cls: type[Message], constant: dict[str, Any],
     records = np.empty(n, dtype=dtype)
     for key, value in fill.items():
         records[key] = np.void(value) if isinstance(value, bytes) else value
-    return _split(records.view(np.uint8).reshape(n, records.dtype.itemsize))
+    return records.view(np.uint8).reshape(n, records.dtype.itemsize)
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -145,7 +146,7 @@ def stamped(times_ns: np.ndarray, layout: Callable[[np.ndarray, np.ndarray], lis
     groups = _timestamps(times_ns.tobytes())
     pieces: list[bytes] = []
     for rows, stamp in groups:
-        pieces += _split(_table(layout(rows, stamp), len(rows)))
+        pieces += messages(_table(layout(rows, stamp), len(rows)))
     if len(groups) == 1:
         return pieces
     order = np.argsort(np.concatenate([rows for rows, _ in groups])).tolist()  # back to time order
@@ -182,7 +183,7 @@ def _table(parts: list[Part], m: int) -> np.ndarray:
     return table
 
 
-def _split(table: np.ndarray) -> list[bytes]:
+def messages(table: np.ndarray) -> list[bytes]:
     """The rows of a (N, w) uint8 table as `bytes`, made in C (a void scalar's Python value is its bytes)."""
     if not table.shape[1]:
         return [b""] * len(table)

@@ -10,23 +10,21 @@ from __future__ import annotations
 
 import functools
 import json
-from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
 from itertools import chain
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import foxglove
 import numpy as np
 import yaml
-from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 from google.protobuf import descriptor_pb2
 from google.protobuf.descriptor import Descriptor
 from google.protobuf.message import Message
 
 from pipeline.core import files, layouts, markers, robot, schemas
 from pipeline.core.decoding import entry_labels, read_topics
-from pipeline.core.encoding import encode_series
+from pipeline.core.encoding import encode_series, messages
+from pipeline.core.mcap_file import McapFile
 from pipeline.robotics.transforms import quaternion_wxyz
 
 if TYPE_CHECKING:  # pandas is for reading runs; a simulate stage does not import it
@@ -36,8 +34,6 @@ RUN_SUFFIX = ".mcap"
 METADATA_NAME = "run"
 CONFIG_ATTACHMENT = "config.yaml"
 MODEL_ATTACHMENT = "model.xml"   # the generated MuJoCo model (MJCF) a run simulates
-CHUNK_BYTES = 1024 * 1024
-COMPRESSION = MCAPCompression.Lz4  # Foxglove, Rerun and the mcap reader all read it; half zstd's cost per message
 UNITS_KEY = "units"   # channel metadata: JSON column -> unit
 # Topics that carry the simulated state: a NaN or an infinity there means the simulation diverged, and the
 # run fails with the first time it happened (every paper gets this watchdog by logging these topics).
@@ -151,6 +147,15 @@ def column_units(cls: type[Message], sample: Mapping[str, Any], units: EntryUnit
     return result
 
 
+def _joined(parts: list[list[bytes] | np.ndarray]) -> list[bytes] | np.ndarray:
+    """A topic's messages in one piece: one table if every part is a table of the same width, else bytes."""
+    if len(parts) == 1:
+        return parts[0]
+    if all(isinstance(p, np.ndarray) for p in parts) and len({p.shape[1] for p in parts}) == 1:
+        return np.concatenate(parts)
+    return list(chain.from_iterable(messages(p) if isinstance(p, np.ndarray) else p for p in parts))
+
+
 # (topic, schema, names, kind, units given, shape of each field) -> column -> unit, for every writer of a process
 _DECLARED: dict[tuple, dict[str, str]] = {}
 
@@ -158,23 +163,18 @@ _DECLARED: dict[tuple, dict[str, str]] = {}
 class RunWriter:
     """Writes one run. Use as a context manager; `close(status)` publishes the file.
 
-    Messages wait in memory per topic and are written topic by topic at close (the MCAP writer is the
-    Foxglove SDK's, in Rust), each topic ending its chunk: a reader that wants one topic then
-    decompresses only that topic's chunks. Series of doubles are encoded in one NumPy pass."""
+    Messages wait in memory per topic and are written topic by topic at close, each topic in chunks of its
+    own (pipeline.core.mcap_file): a reader that wants one topic then decompresses only that topic's chunks.
+    Series of doubles are encoded in one NumPy pass, and framed as MCAP records in another."""
 
     def __init__(self, path: Path, metadata: Mapping[str, Any]):
         self.path = Path(path)
         self._partial = files.temporary_name(self.path)
-        self._context = foxglove.Context()
-        self._writer = foxglove.open_mcap(
-            self._partial, allow_overwrite=True, context=self._context,
-            # chunks, attachments and the summary keep their CRCs; the CRC over the whole data section is left
-            # out, as the mcap package's own writer does by default (a CRC pass over every byte: 4% of the write)
-            writer_options=MCAPWriteOptions(chunk_size=CHUNK_BYTES, compression_threads=0, compression=COMPRESSION,
-                                            calculate_data_section_crc=False))
+        self._file = McapFile(self._partial)
         self._open = True
         self._types: dict[str, type[Message] | tuple] = {}  # protobuf class, or robot.ROS2_STRING
-        self._pending: dict[str, list[tuple[np.ndarray, list[bytes]]]] = {}
+        # topic -> parts of (times in ns, messages: bytes each, or the rows of an (n, w) uint8 table)
+        self._pending: dict[str, list[tuple[np.ndarray, list[bytes] | np.ndarray]]] = {}
         self._units: dict[str, dict[str, str]] = {}   # topic -> column -> unit, written as channel metadata
         self._declared: set[tuple] = set()
         self.metadata = {k: v if isinstance(v, str) else json.dumps(v) for k, v in metadata.items()}
@@ -190,7 +190,8 @@ class RunWriter:
             raise KeyError(f"{topic} is not a common topic: pass its message_type")
         return cls
 
-    def _queue(self, topic: str, message_type: type[Message] | tuple) -> list[tuple[np.ndarray, list[bytes]]]:
+    def _queue(self, topic: str, message_type: type[Message] | tuple) \
+            -> list[tuple[np.ndarray, list[bytes] | np.ndarray]]:
         known = self._types.get(topic)
         if known is None:
             expected = schemas.for_topic(topic)
@@ -371,8 +372,7 @@ class RunWriter:
     def attach(self, name: str, data: bytes | str, media_type: str) -> None:
         if name == MODEL_ATTACHMENT:
             self._model_xml = data if isinstance(data, str) else data.decode()
-        self._writer.attach(log_time=0, create_time=0, name=name, media_type=media_type,
-                            data=data.encode() if isinstance(data, str) else data)
+        self._file.attach(name, media_type, data.encode() if isinstance(data, str) else data)
 
     @property
     def messages(self) -> int:
@@ -387,25 +387,22 @@ class RunWriter:
             kind = self._types[topic]
             if isinstance(kind, tuple):  # a ROS 2 message (mixed encodings in one file are part of MCAP)
                 name, encoding, definition, message_encoding = kind
-                schema = foxglove.Schema(name=name, encoding=encoding, data=definition)
+                schema = (name, encoding, definition)
             else:
-                schema = foxglove.Schema(name=kind.DESCRIPTOR.full_name, encoding="protobuf",
-                                         data=_file_descriptor_set(kind.DESCRIPTOR))
+                schema = (kind.DESCRIPTOR.full_name, "protobuf", _file_descriptor_set(kind.DESCRIPTOR))
                 message_encoding = "protobuf"
             units = self._units.get(topic)
-            channel = foxglove.Channel(topic, schema=schema, message_encoding=message_encoding, context=self._context,
-                                       metadata={UNITS_KEY: json.dumps(units)} if units else None)
+            channel = self._file.add_channel(topic, message_encoding, schema,
+                                             {UNITS_KEY: json.dumps(units)} if units else None)
             times = np.concatenate([t for t, _ in parts])
-            data = parts[0][1] if len(parts) == 1 else list(chain.from_iterable(chunk for _, chunk in parts))
+            data = _joined([chunk for _, chunk in parts])
             if len(times) != len(data):
                 raise ValueError(f"{topic}: {len(data)} messages for {len(times)} times")
             if len(times) > 1 and (np.diff(times) < 0).any():
                 order = np.argsort(times, kind="stable")  # equal times keep their logging order
-                times, data = times[order], [data[i] for i in order.tolist()]
-            # The Rust channel itself (the Python wrapper only re-checks types), called from C by map: no
-            # Python work per message.
-            deque(map(channel.base.log, data, times.tolist()), maxlen=0)
-            self._writer.flush()  # end the chunk: the next topic starts its own
+                times = times[order]
+                data = data[order] if isinstance(data, np.ndarray) else [data[i] for i in order.tolist()]
+            self._file.add_messages(channel, times, data)
         self._pending.clear()
 
     def close(self, status: str) -> Path:
@@ -416,15 +413,15 @@ class RunWriter:
             self.attach(layouts.LAYOUT_ATTACHMENT, layouts.foxglove_layout(self._pending, self.metadata.get("slug")),
                         "application/json")
         self._flush_topics()
-        self._writer.write_metadata(METADATA_NAME, {**self.metadata, "status": status})
-        self._writer.close()
+        self._file.add_metadata(METADATA_NAME, {**self.metadata, "status": status})
+        self._file.finish()
         self._open = False
         return files.publish(self._partial, self.path)
 
     def abort(self) -> None:
         """Drop the unfinished file (interrupt): the previous complete run, if any, is untouched."""
         if self._open:
-            self._writer.close()
+            self._file.close()
             self._open = False
         self._partial.unlink(missing_ok=True)
 
