@@ -43,6 +43,7 @@ CHUNK_BYTES = 1024 * 1024
 LIBRARY = "robotics-repro (pipeline.core.mcap_file)"
 _MESSAGE = np.dtype([("opcode", "u1"), ("length", "<u8"), ("channel", "<u2"), ("sequence", "<u4"),
                      ("log_time", "<u8"), ("publish_time", "<u8")])  # packed: the 31 bytes before each payload
+_MESSAGE_FIELDS = _MESSAGE.descr
 _CONTENT = _MESSAGE.itemsize - 9  # a record's length counts what follows its opcode and length
 _CHUNK_HEAD = struct.Struct("<BQQQQI")  # opcode, length, start and end times, uncompressed size and CRC
 _INDEX_HEAD = struct.Struct("<BQHI")  # opcode, length, channel, byte length of its (log time, offset) pairs
@@ -55,7 +56,7 @@ def _records(channel: int, times_ns: np.ndarray, messages: Messages) -> tuple[me
     n = len(times_ns)
     if isinstance(messages, np.ndarray) and messages.shape[1]:
         width = messages.shape[1]
-        records = np.empty(n, dtype=np.dtype([*_MESSAGE.descr, ("data", "u1", (width,))]))
+        records = np.empty(n, dtype=np.dtype([*_MESSAGE_FIELDS, ("data", "u1", (width,))]))
         records["data"] = messages
         starts = np.arange(n, dtype=np.uint64) * np.uint64(records.dtype.itemsize)
         sizes = np.full(n, width, dtype=np.uint64)
