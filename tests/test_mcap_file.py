@@ -129,9 +129,22 @@ def test_every_crc_and_index_checks_out(tmp_path):
                 assert (channel_id, log_time) == (channel, t) and start + 9 + size <= len(data)
 
 
+def test_a_channel_written_in_parts_goes_on_with_its_sequence(tmp_path):
+    out = McapFile(tmp_path / "parts.mcap")
+    channel = out.add_channel("/a", "protobuf", SCHEMA)
+    out.add_messages(channel, np.array([1, 2]), [b"x", b"y"])
+    out.add_messages(channel, np.array([3]), np.frombuffer(b"z", dtype=np.uint8)[None])
+    out.finish()
+    with open(tmp_path / "parts.mcap", "rb") as f:
+        assert [(m.sequence, m.log_time, m.data) for _, _, m in make_reader(f, validate_crcs=True).iter_messages()] \
+            == [(1, 1, b"x"), (2, 2, b"y"), (3, 3, b"z")]
+
+
 def test_bad_series_are_refused(tmp_path):
     out = McapFile(tmp_path / "bad.mcap")
     channel = out.add_channel("/a", "protobuf", SCHEMA)
+    with pytest.raises(ValueError, match="not added"):
+        out.add_messages(channel + 1, np.array([1]), [b"x"])
     with pytest.raises(ValueError, match="in order"):
         out.add_messages(channel, np.array([2, 1]), [b"x", b"y"])
     with pytest.raises(ValueError, match="2 messages for 3 times"):

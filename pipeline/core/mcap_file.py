@@ -3,8 +3,8 @@
 A run's messages are whole series by the time it closes (pipeline.core.runlog), so a topic's message records
 are built at once: the records of equal-size messages (series encoded by pipeline.core.encoding) are one
 structured array, others are joined with their headers in one `bytes.join`. They are cut into LZ4 chunks of
-about CHUNK_BYTES, each with its message index. A writer that takes one message per call (the Foxglove SDK's,
-used before) spent 0.7 µs on each: half of a UR5 run's logging cost. Every other record is the `mcap`
+about CHUNK_BYTES, each with its message index. (The Foxglove SDK's writer takes one message per call, 0.7 µs
+each: half of a UR5 run's logging cost, which this saves most of.) Every other record is the `mcap`
 package's, and the file carries what a seeking reader, Foxglove and Rerun use: chunk and message indexes,
 attachment and metadata indexes, statistics and summary offsets, with the CRCs of chunks, attachments and the
 summary (the data section's own CRC is left out, as the `mcap` package's writer does by default).
@@ -51,10 +51,12 @@ _INDEX_HEAD = struct.Struct("<BQHI")  # opcode, length, channel, byte length of 
 Messages = np.ndarray | Sequence[bytes]  # (n, w) uint8: n payloads of w bytes; or n payloads as bytes
 
 
-def _records(channel: int, times_ns: np.ndarray, messages: Messages) -> tuple[memoryview, np.ndarray]:
+def _records(channel: int, first_sequence: int, times_ns: np.ndarray,
+             messages: Messages) -> tuple[memoryview, np.ndarray]:
     """The message records of one channel back to back, and where each starts."""
     n = len(times_ns)
-    if isinstance(messages, np.ndarray) and messages.shape[1]:
+    fixed = isinstance(messages, np.ndarray) and messages.shape[1] > 0
+    if fixed:
         width = messages.shape[1]
         records = np.empty(n, dtype=np.dtype([*_MESSAGE_FIELDS, ("data", "u1", (width,))]))
         records["data"] = messages
@@ -70,9 +72,9 @@ def _records(channel: int, times_ns: np.ndarray, messages: Messages) -> tuple[me
     records["opcode"] = Opcode.MESSAGE
     records["length"] = sizes + np.uint64(_CONTENT)
     records["channel"] = channel
-    records["sequence"] = np.arange(1, n + 1)  # per channel, from 1 (as the Foxglove SDK numbers them)
+    records["sequence"] = np.arange(first_sequence, first_sequence + n)  # per channel, from 1
     records["log_time"] = records["publish_time"] = times_ns
-    if records.dtype.names[-1] == "data":
+    if fixed:
         return memoryview(records).cast("B"), starts
     heads = records.tobytes()
     parts: list[bytes] = [b""] * (2 * n)
@@ -145,7 +147,10 @@ class McapFile:
         return channel.id
 
     def add_messages(self, channel: int, times_ns: np.ndarray, messages: Messages) -> None:
-        """All messages of `channel`, log (and publish) time `times_ns` each, in time order."""
+        """Messages of `channel` in log-time order, log (and publish) time `times_ns` each, in chunks of their
+        own; another call for the channel goes on with its sequence numbers."""
+        if channel not in self._channels:
+            raise ValueError(f"channel {channel} was not added (add_channel gives its id)")
         times_ns = np.asarray(times_ns, dtype=np.int64)
         if len(times_ns) != len(messages):
             raise ValueError(f"channel {channel}: {len(messages)} messages for {len(times_ns)} times")
@@ -153,7 +158,8 @@ class McapFile:
             return
         if (np.diff(times_ns) < 0).any() or times_ns[0] < 0:
             raise ValueError(f"channel {channel}: log times must be non-negative and in order")
-        data, starts = _records(channel, times_ns, messages)
+        data, starts = _records(channel, self._statistics.channel_message_counts.get(channel, 0) + 1, times_ns,
+                                messages)
         cuts = [0, *(np.flatnonzero(np.diff(starts // np.uint64(self._chunk_bytes))) + 1).tolist(), len(starts)]
         for first, stop in itertools.pairwise(cuts):
             begin = int(starts[first])
