@@ -119,6 +119,10 @@ def test_randomized_episodes_in_one_process(data_dir):
     (["episodes.count=100000", "scenario.duration=60"], "episodes would need about"),
     (["episodes.count=2", "scenario.algorithms=[alg1,alg2]", "~episodes.randomize.scenario.algorithms"],
      "would make 2 runs"),
+    # every distinct draw of the choices is made, however late it first comes (here in episode 29 of 40)
+    (["episodes.count=40", "seed=2", "~episodes.randomize.scenario.algorithms",
+      "+episodes.randomize.scenario.algorithms={choice:[" + "[alg2]," * 10 + "[alg1,alg2]]}"],
+     "episode 29 would make 2 runs"),
     (["episodes.count=2", "~episodes.randomize.execute.bandwidth_hz",
       "+episodes.randomize.execute.bandwidth_hz={normal:[8,2]}"], "a normal needs clip"),
     (["episodes.count=2", "episodes.randomize.execute.bandwidth_hz={normal:[8,2]}"], "to replace a distribution"),

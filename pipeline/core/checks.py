@@ -219,13 +219,20 @@ def check_episodes(cfg: DictConfig, experiment: Experiment) -> None:
             episodes.check_distribution(key, dist, _select(cfg, key))
         except episodes.BadDistribution as err:
             raise BadInput(str(err)) from None
-    base = OmegaConf.to_container(cfg, resolve=True)
+    # Every episode sets the same keys: one plain config takes each episode's values in turn. How many runs an
+    # episode makes depends on its lists and counts, not on its real numbers: the experiment makes its runs (on
+    # one DictConfig, set likewise) for each of the first 16 distinct draws of its choices and integers.
+    work = episodes.apply(OmegaConf.to_container(cfg, resolve=True), {}, 0)
     defaults = {key: _select(cfg, key) for key in specs}
+    draw = episodes.sampler(cfg)
+    discrete = [key for key, dist in specs.items() if "choice" in dist or "integers" in dist]
+    counted: set[str] = set()
+    episode_cfg: DictConfig | None = None
     total = 0.0
     budget = experiment.budget
     for index in range(count):   # plain dicts: 100,000 episodes are checked in seconds
-        values = episodes.draw(cfg, index)
-        work = episodes.apply(base, values, 0) if index < 16 or index == count - 1 else _set(base, values)
+        values = draw(index)
+        episodes.set_values(work, values)
         for key, value in values.items():
             try:
                 _check_values(key, value, defaults[key], experiment)
@@ -235,8 +242,14 @@ def check_episodes(cfg: DictConfig, experiment: Experiment) -> None:
             found = [_lookup(work, k) for k in rule.keys]
             if all(v is not None for v in found) and not rule.holds(*found):
                 raise BadInput(f"episode {index}: {rule.message.format(*found)}")
-        if index < 16 or index == count - 1:   # the number of runs depends on lists, not on drawn numbers
-            made = experiment.fn(OmegaConf.create(work))
+        signature = repr([values[key] for key in discrete])
+        if signature not in counted and len(counted) < 16:
+            counted.add(signature)
+            if episode_cfg is None:
+                episode_cfg = OmegaConf.create(work)
+            for key, value in values.items():
+                OmegaConf.update(episode_cfg, key, value, merge=False)
+            made = experiment.fn(episode_cfg)
             if len(made) != 1:
                 raise BadInput(f"{experiment.id}: episode {index} would make {len(made)} runs ("
                                f"{', '.join(c.id for c in made[:3])}, ...): an episode is one run; fix or "
@@ -267,17 +280,6 @@ def _lookup(plain: dict, key: str) -> Any:
             return None
         node = node[part]
     return node
-
-
-def _set(plain: dict, values: dict) -> dict:
-    """Write an episode's values into `plain` in place (every episode sets the same keys)."""
-    for key, value in values.items():
-        *parents, last = key.split(".")
-        node = plain
-        for part in parents:
-            node = node[part]
-        node[last] = value
-    return plain
 
 
 def _check_values(key: str, value: Any, default: Any, experiment: Experiment) -> None:

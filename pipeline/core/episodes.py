@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import copy
 import json
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
@@ -135,27 +135,36 @@ def _draw(rng: np.random.Generator, dist: Mapping, default: Any) -> Any:
     return np.asarray(x, dtype=float).tolist() if shape else float(x)
 
 
-def draw(cfg: DictConfig, index: int) -> dict[str, Any]:
-    """The values of episode `index`: key -> value (plain Python, typed like the defaults)."""
-    rng = np.random.default_rng([int(cfg.seed), index])
-    values = {}
-    for key, dist in randomized(cfg).items():
-        values[key] = _draw(rng, dist, _plain(OmegaConf.select(cfg, key, default=None)))
-    return values
+def sampler(cfg: DictConfig) -> Callable[[int], dict[str, Any]]:
+    """`draw(index)`: the values of episode `index`, key -> value (plain Python, typed like the defaults). The
+    distributions and their defaults are read from the config once, not once per episode."""
+    seed, distributions = int(cfg.seed), randomized(cfg)
+    defaults = {key: _plain(OmegaConf.select(cfg, key, default=None)) for key in distributions}
+
+    def draw(index: int) -> dict[str, Any]:
+        rng = np.random.default_rng([seed, index])
+        return {key: _draw(rng, dist, defaults[key]) for key, dist in distributions.items()}
+
+    return draw
 
 
 def apply(base: dict, values: Mapping[str, Any], seed: int) -> dict:
     """A copy of the plain config `base` with an episode's values and seed, and no episodes of its own."""
     episode = copy.deepcopy(base)
-    for key, value in values.items():
-        *parents, last = key.split(".")
-        node = episode
-        for part in parents:
-            node = node[part]
-        node[last] = value
+    set_values(episode, values)
     episode["episodes"]["count"] = 0
     episode["seed"] = seed
     return episode
+
+
+def set_values(plain: dict, values: Mapping[str, Any]) -> None:
+    """Write an episode's values into the plain config `plain`, in place."""
+    for key, value in values.items():
+        *parents, last = key.split(".")
+        node = plain
+        for part in parents:
+            node = node[part]
+        node[last] = value
 
 
 def seed_of(cfg: DictConfig, index: int) -> int:

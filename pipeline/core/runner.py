@@ -125,9 +125,10 @@ def _runs(cfg: DictConfig, experiment, cases, ids: list[str], out_dir: Path, con
         return
     described = {key: episodes.describe(dist) for key, dist in episodes.randomized(cfg).items()}
     base = OmegaConf.to_container(cfg, resolve=True)
+    draw = episodes.sampler(cfg)
 
     def episode(index: int) -> tuple[str, str, bool]:
-        values = episodes.draw(cfg, index)
+        values = draw(index)
         plain = episodes.apply(base, values, episodes.seed_of(cfg, index))
         case = experiment.fn(OmegaConf.create(plain))[0]
         status, bug = _run_case(case, ids[index], out_dir, yaml.safe_dump(plain, sort_keys=False), {

@@ -11,7 +11,6 @@ from __future__ import annotations
 import itertools
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from pipeline.papers.dyad_triad_synthesis.standard_form import turns
 
@@ -102,6 +101,8 @@ def least_squares_dyads(points, alpha, starts: int, rng: np.random.Generator, bo
     """Finite dyads (W, Z) of five positions solved directly from the circle-point condition (|P_j +
     e^{iα_j} m − C| equal for all j) by least squares from random starts in a box `box` times the size of the
     precision points around their centre; distinct converged solutions only."""
+    from scipy.optimize import least_squares  # 0.3 s to import: only this solver needs it
+
     p, rot = np.asarray(points, dtype=complex), turns(np.asarray(alpha, dtype=float) - alpha[0])
     centre = p.mean()
     scale = max(float(np.abs(p - centre).max()), 1e-9)

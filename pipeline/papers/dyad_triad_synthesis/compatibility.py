@@ -25,7 +25,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.polynomial import polynomial as poly
-from scipy.optimize import brentq
 
 from pipeline.papers.dyad_triad_synthesis.standard_form import Chain, Loop, link_vectors, loops, turns
 
@@ -147,6 +146,8 @@ class Compatibility:
         return unique(found, same)
 
     def _roots_1d(self, grid: int) -> list[Root]:
+        from scipy.optimize import brentq  # 0.3 s to import: not for the experiments that find no roots
+
         samples = np.unique(np.concatenate([np.linspace(-math.pi, math.pi, grid), self.sweep_limits()]))
         found = []
         for branch in BRANCHES:

@@ -115,7 +115,8 @@ class Curated:
 
 
 def load_yaml(path: Path) -> Any:
-    return yaml.safe_load(Path(path).read_text())
+    # libyaml's safe loader where PyYAML has it: the same values, ten times faster than the pure-Python one
+    return yaml.load(Path(path).read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
 
 
 def load_tables(path: Path = TABLES_FILE) -> dict:

@@ -219,12 +219,13 @@ def dataset(rows: list[dict], episodes: int = 1000) -> None:
     cfg = compose_config(["experiment=ur5-ik-fsm/random-paths"])
     experiment = resolve("ur5-ik-fsm/random-paths")
     base = OmegaConf.to_container(cfg, resolve=True)
+    draw = ep.sampler(cfg)
     parts: dict[str, list[float]] = {"config": [], "IK along the path (2001 scalar calls)": [],
                                      "MuJoCo servo (rollout)": [], "logging + MCAP write": [], "episode": []}
     with tempfile.TemporaryDirectory() as tmp:
         for index in range(12):
             t0 = time.perf_counter()
-            plain = ep.apply(base, ep.draw(cfg, index), ep.seed_of(cfg, index))
+            plain = ep.apply(base, draw(index), ep.seed_of(cfg, index))
             episode_cfg = OmegaConf.create(plain)
             case = experiment.fn(episode_cfg)[0]
             config_yaml = yaml.safe_dump(plain, sort_keys=False)
