@@ -269,9 +269,11 @@ def pose_residual(q: np.ndarray, geo: np.ndarray, T: np.ndarray, J: np.ndarray, 
         J[1, i] = z[i, 2] * r[0] - z[i, 0] * r[2]
         J[2, i] = z[i, 0] * r[1] - z[i, 1] * r[0]
         J[3, i], J[4, i], J[5, i] = z[i, 0], z[i, 1], z[i, 2]
-    E = T[:3, :3] @ F[:3, :3].T
+    E = np.empty((3, 3))   # R_T R_Fᵀ, written out: `@` on the 4x4s' 3x3 blocks (strided) takes Numba's slow path
     for i in range(3):
         e[i] = T[i, 3] - F[i, 3]
+        for j in range(3):
+            E[i, j] = T[i, 0] * F[j, 0] + T[i, 1] * F[j, 1] + T[i, 2] * F[j, 2]
     e[3], e[4], e[5] = 0.5 * (E[2, 1] - E[1, 2]), 0.5 * (E[0, 2] - E[2, 0]), 0.5 * (E[1, 0] - E[0, 1])
 
 
