@@ -1,8 +1,9 @@
 """A* on a graph with the paper's cost/heuristic pairs (Secs. 3.3, 4.2), and the same A* on the plain C-grid.
 
-One compiled A* (a binary heap of (f, vertex) on arrays, lazy deletion, re-opening of closed vertices when a cheaper
-path is found, as Boost's astar_search that graph-tool wraps) serves the KG and the C-space grid alike: both are
-CSR successor lists with per-edge costs and a per-vertex heuristic, so the comparison differs only in the graph.
+One compiled A* (`astar.py`: a binary heap of (f, vertex) on arrays, lazy deletion, re-opening of closed vertices
+when a cheaper path is found, as Boost's astar_search that graph-tool wraps) serves the KG and the C-space grid alike:
+both are CSR successor lists with per-edge costs and a per-vertex heuristic, so the comparison differs only in the
+graph.
 
 Metrics (the printed formulas of (11)/(12); (a), (b) are not printed: Euclidean norms):
     cspace          c = ‖C.q − C'.q‖,                 h = ‖q_goal − C.q‖, the goal vertex by Sec. 4.2.2
@@ -18,9 +19,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 from scipy import sparse
-from scipy.spatial import cKDTree
 
 from pipeline.papers.kinematic_graph.graph import voxel_box, voxel_index, voxel_keys
 
@@ -31,121 +30,14 @@ METRICS = ("cspace", "tspace", "manipulability", "manipulability-admissible")
 _CODES = {metric: k for k, metric in enumerate(METRICS)}
 
 
-@njit(cache=True)
-def _heuristic(code, v, q, pos, weight, q_goal, goal, diagonal, w_min):  # pragma: no cover - compiled
-    if code < 0:                                    # none: Dijkstra
-        return 0.0
-    if code == 0:                                   # cspace: ‖q_goal − C.q‖
-        s = 0.0
-        for j in range(q.shape[1]):
-            s += (q_goal[j] - q[v, j]) ** 2
-        return np.sqrt(s)
-    s = 0.0
-    for j in range(pos.shape[1]):
-        s += (goal[j] - pos[v, j]) ** 2
-    if code == 1:                                   # tspace: ‖P_w,g − C.pos‖
-        return np.sqrt(s)
-    if code == 2:                                   # eq. (12): ‖P_w,g − C.pos‖² (μ_max − μ(C.q))
-        return s * weight[v]
-    return max(np.sqrt(s) - diagonal, 0.0) * w_min  # the admissible bound
-
-
 def heuristic_values(space, metric: str, query, q_goal: np.ndarray) -> np.ndarray:
     """The heuristic of `metric` at every vertex (what A* evaluates vertex by vertex), e.g. for Fig. 3."""
+    from pipeline.papers.kinematic_graph.astar import heuristic
+
     goal = np.asarray(query.goal, dtype=float)
     diagonal = space.t_res * np.sqrt(space.pos.shape[1])
-    return np.array([_heuristic(_CODES[metric], v, space.q, space.pos, space.weight, np.asarray(q_goal, dtype=float),
-                                goal, diagonal, space.w_min) for v in range(space.size)])
-
-
-@njit(cache=True)
-def _push(keys, items, size, key, item):  # pragma: no cover - compiled
-    """Binary min-heap on parallel arrays (grown by the caller): sift `key` up from position `size`."""
-    i = size
-    while i > 0:
-        up = (i - 1) >> 1
-        if keys[up] <= key:
-            break
-        keys[i], items[i] = keys[up], items[up]
-        i = up
-    keys[i], items[i] = key, item
-
-
-@njit(cache=True)
-def _pop(keys, items, size):  # pragma: no cover - compiled
-    """Remove the root of a heap of `size` entries; returns it (key, item)."""
-    key, item = keys[0], items[0]
-    last_key, last_item = keys[size - 1], items[size - 1]
-    size -= 1
-    i = 0
-    while True:
-        child = 2 * i + 1
-        if child >= size:
-            break
-        if child + 1 < size and keys[child + 1] < keys[child]:
-            child += 1
-        if keys[child] >= last_key:
-            break
-        keys[i], items[i] = keys[child], items[child]
-        i = child
-    if size > 0:
-        keys[i], items[i] = last_key, last_item
-    return key, item
-
-
-@njit(cache=True)
-def astar(indptr, indices, costs, blocked, goal_mask, start, limit, code, q, pos, weight, q_goal, goal, diagonal,
-          w_min):  # pragma: no cover - compiled
-    """A* from `start` to the first goal vertex popped; the heuristic is evaluated when a vertex is first met.
-    Returns (reached goal, −1 if none is connected, −2 if `limit` expansions did not reach it; g, parent,
-    expanded, met, expansions): g and parent per vertex; expanded marks the vertices expanded at least once
-    (green in Fig. 5), met those ever queued (green + yellow); expansions counts every expansion, re-openings
-    included (an inconsistent heuristic can make them exponential, hence the limit)."""
-    n = len(blocked)
-    g = np.full(n, np.inf)
-    h = np.full(n, np.nan)
-    parent = np.full(n, -1, dtype=np.int64)
-    closed = np.zeros(n, dtype=np.bool_)
-    expanded = np.zeros(n, dtype=np.bool_)
-    met = np.zeros(n, dtype=np.bool_)
-    keys = np.empty(1024)
-    items = np.empty(1024, dtype=np.int64)
-    g[start] = 0.0
-    met[start] = True
-    h[start] = _heuristic(code, start, q, pos, weight, q_goal, goal, diagonal, w_min)
-    _push(keys, items, 0, h[start], start)
-    size = 1
-    expansions = 0
-    while size > 0:
-        f, u = _pop(keys, items, size)
-        size -= 1
-        if closed[u] or f > g[u] + h[u]:
-            continue   # stale entry
-        if goal_mask[u]:
-            return u, g, parent, expanded, met, expansions
-        if expansions == limit:
-            return -2, g, parent, expanded, met, expansions
-        closed[u] = True
-        expanded[u] = True
-        expansions += 1
-        for k in range(indptr[u], indptr[u + 1]):
-            v = indices[k]
-            if blocked[v]:
-                continue
-            cand = g[u] + costs[k]
-            if cand < g[v]:
-                if not met[v]:
-                    met[v] = True
-                    h[v] = _heuristic(code, v, q, pos, weight, q_goal, goal, diagonal, w_min)
-                g[v] = cand
-                parent[v] = u
-                closed[v] = False   # re-open: an inconsistent heuristic may close a vertex too early
-                if size == len(keys):
-                    keys = np.concatenate((keys, np.empty(size)))
-                    items = np.concatenate((items, np.empty(size, dtype=np.int64)))
-                _push(keys, items, size, cand + h[v], v)
-                size += 1
-    return -1, g, parent, expanded, met, expansions
+    return np.array([heuristic(_CODES[metric], v, space.q, space.pos, space.weight, np.asarray(q_goal, dtype=float),
+                               goal, diagonal, space.w_min) for v in range(space.size)])
 
 
 @dataclass
@@ -165,6 +57,8 @@ class Space:
         self.pos = np.ascontiguousarray(self.pos)
         self.weight = np.clip(self.mu_max - self.mu, 0.0, None)   # round-off must not make a cost negative
         self.w_min = float(self.weight.min()) if self.size else 0.0
+        from scipy.spatial import cKDTree
+
         self._tree = cKDTree(self.q)
         self._box = voxel_box(self.voxel)
         keys = voxel_keys(self.voxel, self._box)
@@ -265,6 +159,8 @@ class Planner:
         """Plan from q_i to the voxel of P_w,g avoiding the `blocked` (colliding) vertices. `keep_masks` keeps the
         expanded and queued vertices on the plan (the colours of Fig. 5); `dijkstra` drops the heuristic (h = 0),
         which gives the cheapest path of the metric's costs."""
+        from pipeline.papers.kinematic_graph.astar import astar, heuristic
+
         space, costs = self.space, self.costs(metric)
         start_time = time.perf_counter()
         start = space.start_vertex(query.q_start, blocked)
@@ -288,8 +184,8 @@ class Planner:
         reason = {-1: "goal not connected to the start", -2: f"more than {self.limit} expansions"}.get(reached, "")
         plan = Plan(metric, reached >= 0, np.empty(0, np.int64), np.nan, np.count_nonzero(expanded),
                     np.count_nonzero(met), expansions, seconds, reason)
-        plan.h_start = _heuristic(_CODES[metric], start, space.q, space.pos, space.weight, q_goal,
-                                  np.asarray(query.goal, dtype=float), diagonal, space.w_min)
+        plan.h_start = heuristic(_CODES[metric], start, space.q, space.pos, space.weight, q_goal,
+                                 np.asarray(query.goal, dtype=float), diagonal, space.w_min)
         if keep_masks:
             plan.expanded_mask, plan.met_mask = expanded, met
         if reached >= 0:
