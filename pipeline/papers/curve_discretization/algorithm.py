@@ -21,7 +21,6 @@ from math import comb
 
 import numpy as np
 from numba import njit
-from scipy.linalg import expm
 
 # Curve kinds the compiled kernels evaluate (`Curve.kind`); `params` is a flat float array.
 POLYNOMIAL = 0       # power-basis coefficients, highest degree first, 3 per degree: (x, y, z)
@@ -310,6 +309,8 @@ def poe_forward_kinematics(p1: np.ndarray, theta_z0: float, theta_y0: float, the
                            chain: Chain, printed_twist_hat: bool = False) -> np.ndarray:
     """(N, 4, 4) g_{w,m} by the product of exponentials: eq. (15) for g_{w,1}, then eq. (8) with the twists of
     eqs. (4), (11), (12) and g_{1,m}(0) of eq. (9), every exponential by expm of eq. (3)."""
+    from scipy.linalg import expm  # 0.1 s to import: only this check needs it, not the snake's runs
+
     p1 = np.asarray(p1, dtype=float)
     distance = float(np.linalg.norm(p1))
     x, y, z = np.eye(3)
