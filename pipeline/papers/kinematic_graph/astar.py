@@ -11,6 +11,7 @@ from numba import njit
 
 @njit(cache=True)
 def heuristic(code, v, q, pos, weight, q_goal, goal, diagonal, w_min):  # pragma: no cover - compiled
+    """h at vertex v for the metric numbered `code` (`search.METRICS` order; < 0: none, which is Dijkstra)."""
     if code < 0:                                    # none: Dijkstra
         return 0.0
     if code == 0:                                   # cspace: ‖q_goal − C.q‖
